@@ -1,0 +1,10 @@
+// rsvio compare: placeholder until its issue lands; says so and exits non-zero.
+#include "commands.h"
+
+namespace rsvio::app {
+void addCompareCommand(CLI::App& root, const GlobalOptions& /*g*/, CommandResult& r) {
+  auto* sub = root.add_subcommand("compare", "(not available yet)");
+  sub->allow_extras();
+  sub->callback([&r] { r.exit_code = notAvailableYet("compare", "its issue has not landed"); });
+}
+}  // namespace rsvio::app

@@ -1,0 +1,10 @@
+// rsvio diagnose: placeholder until its issue lands; says so and exits non-zero.
+#include "commands.h"
+
+namespace rsvio::app {
+void addDiagnoseCommand(CLI::App& root, const GlobalOptions& /*g*/, CommandResult& r) {
+  auto* sub = root.add_subcommand("diagnose", "(not available yet)");
+  sub->allow_extras();
+  sub->callback([&r] { r.exit_code = notAvailableYet("diagnose", "its issue has not landed"); });
+}
+}  // namespace rsvio::app

@@ -1,0 +1,10 @@
+// rsvio eval: placeholder until its issue lands; says so and exits non-zero.
+#include "commands.h"
+
+namespace rsvio::app {
+void addEvalCommand(CLI::App& root, const GlobalOptions& /*g*/, CommandResult& r) {
+  auto* sub = root.add_subcommand("eval", "(not available yet)");
+  sub->allow_extras();
+  sub->callback([&r] { r.exit_code = notAvailableYet("eval", "its issue has not landed"); });
+}
+}  // namespace rsvio::app

@@ -1,0 +1,22 @@
+# Helpers shared by every part of the build.
+
+# Build fingerprint compiled into the framework and into every plugin; the host refuses a plugin
+# whose fingerprint differs (C++ objects and Eigen types cross the boundary only between matching builds).
+set(RSVIO_FINGERPRINT "${CMAKE_CXX_COMPILER_ID}-${CMAKE_CXX_COMPILER_VERSION};eigen-${Eigen3_VERSION};${CMAKE_BUILD_TYPE}")
+
+# rsvio_add_plugin(<kind> <name> SOURCES a.cpp ... [LIBS ...])
+# Builds plugins/<kind>/<name> as MODULE rsvio_<kind>_<name>.so into <bin>/plugins, hidden visibility,
+# linked against the framework. The module must define RSVIO_PLUGIN_ENTRY (rsvio/plugin/plugin_api.h).
+function(rsvio_add_plugin kind name)
+  cmake_parse_arguments(P "" "" "SOURCES;LIBS" ${ARGN})
+  set(tgt rsvio_${kind}_${name})
+  add_library(${tgt} MODULE ${P_SOURCES})
+  target_link_libraries(${tgt} PRIVATE rsvio_framework ${P_LIBS})
+  set_target_properties(${tgt} PROPERTIES
+    PREFIX ""
+    CXX_VISIBILITY_PRESET hidden
+    VISIBILITY_INLINES_HIDDEN ON
+    LIBRARY_OUTPUT_DIRECTORY ${RSVIO_PLUGIN_OUTPUT_DIR})
+  target_compile_definitions(${tgt} PRIVATE RSVIO_PLUGIN_NAME="${kind}.${name}")
+  set_property(GLOBAL APPEND PROPERTY RSVIO_PLUGIN_TARGETS ${tgt})
+endfunction()
