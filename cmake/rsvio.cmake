@@ -2,7 +2,7 @@
 
 # Build fingerprint compiled into the framework and into every plugin; the host refuses a plugin
 # whose fingerprint differs (C++ objects and Eigen types cross the boundary only between matching builds).
-set(RSVIO_FINGERPRINT "${CMAKE_CXX_COMPILER_ID}-${CMAKE_CXX_COMPILER_VERSION};eigen-${Eigen3_VERSION};${CMAKE_BUILD_TYPE}")
+set(RSVIO_FINGERPRINT "${CMAKE_CXX_COMPILER_ID}-${CMAKE_CXX_COMPILER_VERSION}/eigen-${Eigen3_VERSION}/${CMAKE_BUILD_TYPE}")
 
 # rsvio_add_plugin(<kind> <name> SOURCES a.cpp ... [LIBS ...])
 # Builds plugins/<kind>/<name> as MODULE rsvio_<kind>_<name>.so into <bin>/plugins, hidden visibility,

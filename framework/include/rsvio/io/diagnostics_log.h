@@ -1,0 +1,62 @@
+// The diagnostics log (diagnostics.bin): what `rsvio diagnose` needs from a run, compact and binary.
+//
+// One ObservationRow per point observation at its final linearisation (when the observation leaves the
+// window: marginalised or at the end of the run), one ImuRow per IMU factor (keyframe pair).
+// Fields (float32 unless stated):
+//   t_ns (int64)          capture time of the target frame's row y0, camera clock
+//   frame, host (int32)   target and host frame indices (sequence positions)
+//   u, v                  projected raw pixel in the target (the pattern centre)
+//   row                   raw row minus y0 (v - y0): where a rolling shutter shows
+//   radius                distance from the principal point, normalised by the half diagonal (vignetting)
+//   intensity             host intensity at the point (response, exposure)
+//   grad_u, grad_v        target image gradient at (u, v)
+//   vel_u, vel_v          pixel velocity in the target [px/s] from the frame's twist (d uv/dt)
+//   residual, weight      mean pattern residual and its robust weight
+//   exposure_ratio        exp(a_target - a_host) when affine brightness is estimated, else 1
+// File layout: magic "RSVIODG1", uint32 version, uint32 sizeof(ObservationRow), uint32 sizeof(ImuRow),
+// uint64 n_obs, uint64 n_imu, then the rows, little-endian as on x86-64 / aarch64.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace rsvio {
+
+#pragma pack(push, 1)
+struct ObservationRow {
+  int64_t t_ns = 0;
+  int32_t frame = 0;
+  int32_t host = 0;
+  float u = 0, v = 0;
+  float row = 0;
+  float radius = 0;
+  float intensity = 0;
+  float grad_u = 0, grad_v = 0;
+  float vel_u = 0, vel_v = 0;
+  float residual = 0;
+  float weight = 0;
+  float exposure_ratio = 1;
+};
+
+struct ImuRow {
+  int64_t t_i_ns = 0;
+  int64_t t_j_ns = 0;
+  std::array<float, 15> residual{};    // rotation, velocity, position, bias gyro, bias accel (eqs. 16-19)
+  std::array<float, 15> whitened{};    // residual times the square-root information
+};
+#pragma pack(pop)
+
+struct DiagnosticsLog {
+  int width = 0;                       // raw image size of the run's camera
+  int height = 0;
+  double line_delay_s = 0.0;           // as modelled by the run (0: global shutter)
+  std::vector<ObservationRow> observations;
+  std::vector<ImuRow> imu;
+
+  void write(const std::string& path) const;               // throws Error on I/O failure
+  static DiagnosticsLog read(const std::string& path);     // throws DataError on a bad file
+};
+
+}  // namespace rsvio

@@ -1,0 +1,169 @@
+#include "rsvio/config/config.h"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "rsvio/core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace rsvio {
+
+namespace {
+
+// Line and column (1-based) of a byte offset, for parse errors.
+std::pair<size_t, size_t> lineCol(const std::string& text, size_t byte) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return {line, col};
+}
+
+nlohmann::json loadRecursive(const fs::path& path, std::set<std::string>& chain) {
+  std::error_code ec;
+  const fs::path canon = fs::weakly_canonical(path, ec);
+  const std::string key = ec ? path.string() : canon.string();
+  if (chain.count(key)) throw ConfigError(path.string() + ": \"extends\" forms a cycle");
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path.string() + ": cannot open config file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  nlohmann::json j = parseJsonText(ss.str(), path.string());
+  if (!j.is_object()) throw ConfigError(path.string() + ": a config must be a JSON object");
+  if (!j.contains("extends")) return j;
+  const nlohmann::json ext = j["extends"];
+  j.erase("extends");
+  std::vector<std::string> bases;
+  if (ext.is_string()) {
+    bases.push_back(ext.get<std::string>());
+  } else if (ext.is_array()) {
+    for (const auto& e : ext) {
+      if (!e.is_string()) throw ConfigError(path.string() + ": extends: expected a file name or a list of them");
+      bases.push_back(e.get<std::string>());
+    }
+  } else {
+    throw ConfigError(path.string() + ": extends: expected a file name or a list of them, found " + ext.dump());
+  }
+  chain.insert(key);
+  nlohmann::json merged = nlohmann::json::object();
+  for (const auto& b : bases) {
+    fs::path bp = fs::path(b).is_absolute() ? fs::path(b) : path.parent_path() / b;
+    if (!fs::exists(bp))
+      throw ConfigError(path.string() + ": extends: base config '" + b + "' not found (looked at " + bp.string() +
+                        ")");
+    merged = mergeConfig(merged, loadRecursive(bp, chain));
+  }
+  chain.erase(key);
+  // Keep nulls of this file until the end, so they can remove keys of the base.
+  return mergeConfig(merged, j);
+}
+
+void dropNulls(nlohmann::json& j) {
+  if (!j.is_object()) return;
+  for (auto it = j.begin(); it != j.end();) {
+    if (it->is_null()) {
+      it = j.erase(it);
+    } else {
+      dropNulls(*it);
+      ++it;
+    }
+  }
+}
+
+}  // namespace
+
+nlohmann::json parseJsonText(const std::string& text, const std::string& origin) {
+  try {
+    return nlohmann::json::parse(text, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::parse_error& e) {
+    auto [line, col] = lineCol(text, e.byte > 0 ? e.byte - 1 : 0);
+    std::string what = e.what();
+    // nlohmann's message is "[json.exception.parse_error.101] parse error at line 3, column 5: ..."; keep the reason.
+    const auto colon = what.rfind(": ");
+    std::string reason = colon == std::string::npos ? what : what.substr(colon + 2);
+    throw ConfigError(origin + ":" + std::to_string(line) + ":" + std::to_string(col) + ": invalid JSON: " + reason);
+  }
+}
+
+nlohmann::json mergeConfig(const nlohmann::json& base, const nlohmann::json& overlay) {
+  if (!base.is_object() || !overlay.is_object()) return overlay;
+  nlohmann::json out = base;
+  for (auto it = overlay.begin(); it != overlay.end(); ++it) {
+    if (it->is_null()) {
+      out.erase(it.key());
+    } else if (out.contains(it.key()) && out[it.key()].is_object() && it->is_object()) {
+      out[it.key()] = mergeConfig(out[it.key()], *it);
+    } else {
+      out[it.key()] = *it;
+    }
+  }
+  return out;
+}
+
+nlohmann::json loadConfig(const std::string& path) {
+  std::set<std::string> chain;
+  nlohmann::json j = loadRecursive(path, chain);
+  dropNulls(j);
+  return j;
+}
+
+void applySet(nlohmann::json& config, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos)
+    throw ConfigError("--set " + assignment + ": expected key=value (e.g. --set frontend.points=800)");
+  const std::string path = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  if (path.empty()) throw ConfigError("--set " + assignment + ": empty key");
+  nlohmann::json value;
+  try {
+    value = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error&) {
+    value = text;  // a bare word is a string: --set shutter.plugin=shutter.rolling
+  }
+  nlohmann::json* node = &config;
+  std::stringstream ss(path);
+  std::string part;
+  std::vector<std::string> parts;
+  while (std::getline(ss, part, '.')) {
+    if (part.empty()) throw ConfigError("--set " + assignment + ": empty component in key '" + path + "'");
+    parts.push_back(part);
+  }
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    nlohmann::json& next = (*node)[parts[i]];
+    if (next.is_null()) next = nlohmann::json::object();
+    if (!next.is_object())
+      throw ConfigError("--set " + assignment + ": '" + parts[i] + "' is not an object (found " + next.dump() + ")");
+    node = &next;
+  }
+  if (value.is_null())
+    node->erase(parts.back());
+  else
+    (*node)[parts.back()] = value;
+}
+
+void applySets(nlohmann::json& config, const std::vector<std::string>& assignments) {
+  for (const auto& a : assignments) applySet(config, a);
+}
+
+nlohmann::json loadConfigWithSets(const std::string& path, const std::vector<std::string>& sets) {
+  nlohmann::json j = loadConfig(path);
+  applySets(j, sets);
+  return j;
+}
+
+void writeConfig(const nlohmann::json& config, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot write config");
+  out << config.dump(2) << "\n";
+  if (!out) throw Error(path + ": write failed");
+}
+
+}  // namespace rsvio

@@ -1,0 +1,76 @@
+#include "rsvio/io/diagnostics_log.h"
+
+#include <cstring>
+#include <fstream>
+
+#include "rsvio/core/error.h"
+
+namespace rsvio {
+
+namespace {
+constexpr char kMagic[8] = {'R', 'S', 'V', 'I', 'O', 'D', 'G', '1'};
+constexpr uint32_t kVersion = 1;
+
+struct Header {
+  char magic[8];
+  uint32_t version;
+  uint32_t obs_size;
+  uint32_t imu_size;
+  int32_t width;
+  int32_t height;
+  double line_delay_s;
+  uint64_t n_obs;
+  uint64_t n_imu;
+};
+}  // namespace
+
+void DiagnosticsLog::write(const std::string& path) const {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw Error(path + ": cannot write diagnostics log");
+  Header h{};
+  std::memcpy(h.magic, kMagic, 8);
+  h.version = kVersion;
+  h.obs_size = sizeof(ObservationRow);
+  h.imu_size = sizeof(ImuRow);
+  h.width = width;
+  h.height = height;
+  h.line_delay_s = line_delay_s;
+  h.n_obs = observations.size();
+  h.n_imu = imu.size();
+  out.write(reinterpret_cast<const char*>(&h), sizeof(h));
+  out.write(reinterpret_cast<const char*>(observations.data()),
+            static_cast<std::streamsize>(observations.size() * sizeof(ObservationRow)));
+  out.write(reinterpret_cast<const char*>(imu.data()), static_cast<std::streamsize>(imu.size() * sizeof(ImuRow)));
+  if (!out) throw Error(path + ": write failed");
+}
+
+DiagnosticsLog DiagnosticsLog::read(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw DataError(path + ": cannot open diagnostics log");
+  Header h{};
+  in.read(reinterpret_cast<char*>(&h), sizeof(h));
+  if (!in || std::memcmp(h.magic, kMagic, 8) != 0) throw DataError(path + ": not an rsvio diagnostics log");
+  if (h.version != kVersion || h.obs_size != sizeof(ObservationRow) || h.imu_size != sizeof(ImuRow))
+    throw DataError(path + ": diagnostics log version " + std::to_string(h.version) + " not supported (expected " +
+                    std::to_string(kVersion) + ")");
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<uint64_t>(in.tellg());
+  const uint64_t expect = sizeof(h) + h.n_obs * sizeof(ObservationRow) + h.n_imu * sizeof(ImuRow);
+  if (size != expect)
+    throw DataError(path + ": truncated or corrupt diagnostics log (" + std::to_string(size) + " bytes, expected " +
+                    std::to_string(expect) + ")");
+  in.seekg(sizeof(h));
+  DiagnosticsLog log;
+  log.width = h.width;
+  log.height = h.height;
+  log.line_delay_s = h.line_delay_s;
+  log.observations.resize(h.n_obs);
+  log.imu.resize(h.n_imu);
+  in.read(reinterpret_cast<char*>(log.observations.data()),
+          static_cast<std::streamsize>(h.n_obs * sizeof(ObservationRow)));
+  in.read(reinterpret_cast<char*>(log.imu.data()), static_cast<std::streamsize>(h.n_imu * sizeof(ImuRow)));
+  if (!in) throw DataError(path + ": read failed");
+  return log;
+}
+
+}  // namespace rsvio
