@@ -150,12 +150,18 @@ std::optional<int64_t> parseSecondsToNs(const std::string& token) {
   return sToNs(v);
 }
 
-std::string formatTumLine(const StampedPose& pose) {
-  const int64_t t = pose.t_ns;
+std::string formatSeconds(int64_t t) {
   const uint64_t mag = t < 0 ? static_cast<uint64_t>(-(t + 1)) + 1 : static_cast<uint64_t>(t);
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "%s%" PRIu64 ".%09" PRIu64, t < 0 ? "-" : "", mag / 1000000000ULL,
+                mag % 1000000000ULL);
+  return buf;
+}
+
+std::string formatTumLine(const StampedPose& pose) {
   char buf[256];
-  std::snprintf(buf, sizeof(buf), "%s%" PRIu64 ".%09" PRIu64 " %.9f %.9f %.9f %.9f %.9f %.9f %.9f",
-                t < 0 ? "-" : "", mag / 1000000000ULL, mag % 1000000000ULL, pose.p_W_X.x(), pose.p_W_X.y(),
+  std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f", formatSeconds(pose.t_ns).c_str(),
+                pose.p_W_X.x(), pose.p_W_X.y(),
                 pose.p_W_X.z(), pose.q_W_X.x(), pose.q_W_X.y(), pose.q_W_X.z(), pose.q_W_X.w());
   return buf;
 }
@@ -300,9 +306,7 @@ Trajectory readGroundTruth(const std::string& path) {
     throw DataError::at(path, line, "comma-separated ground truth needs 17 columns (EuRoC state: t_ns, p, q, v, "
                                     "bg, ba) or 8 (EuRoC mocap: t_ns, p, q), found " + std::to_string(n_cols));
   }
-  Trajectory traj = readTum(path);
-  if (traj.frame == PoseFrame::kUnknown) traj.frame = PoseFrame::kBody;
-  return traj;
+  return readTum(path);
 }
 
 std::optional<std::string> findDatasetGroundTruth(const std::string& dataset_dir) {

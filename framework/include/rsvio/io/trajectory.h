@@ -58,6 +58,8 @@ Trajectory readTum(const std::string& path);
 void writeTum(const std::string& path, const Trajectory& traj);
 // Formats one pose line exactly as writeTum does (no newline). Seconds come from t_ns without rounding.
 std::string formatTumLine(const StampedPose& pose);
+// t_ns as seconds with exactly 9 decimals ("-" for negative), no rounding through double.
+std::string formatSeconds(int64_t t_ns);
 // "1311868164.363181" -> 1311868164363181000 exactly (decimal strings are converted digit by digit;
 // exponent notation goes through double). Returns nullopt on a malformed or non-finite number.
 std::optional<int64_t> parseSecondsToNs(const std::string& token);
@@ -67,8 +69,9 @@ std::vector<GroundTruthState> readEurocStateGroundTruth(const std::string& path)
 Trajectory readEurocMocap(const std::string& path);  // frame kBody
 
 // Any ground-truth file: EuRoC state (17 columns) or mocap (8 columns) when comma separated,
-// otherwise TUM (comment lines allowed, e.g. TUM RGB-D's fr2_desk_groundtruth.txt). A TUM file
-// without a frame header is taken as body poses.
+// otherwise TUM (comment lines allowed, e.g. TUM RGB-D's fr2_desk_groundtruth.txt). EuRoC files are
+// body poses; a TUM file keeps its header's frame (kUnknown without one: TUM RGB-D's ground truth is
+// of a mocap marker frame, neither our body nor our camera).
 Trajectory readGroundTruth(const std::string& path);
 
 // <dir>/mav0/state_groundtruth_estimate0/data.csv if it exists, else <dir>/mav0/mocap0/data.csv;
