@@ -14,7 +14,10 @@
 #include <vector>
 
 #include "rsvio/core/types.h"
+#include "rsvio/imu/imu_frames.h"
 #include "rsvio/imu/imu_types.h"
+#include "rsvio/lie/rxso3.h"
+#include "rsvio/lie/se3.h"
 #include "rsvio/lie/so3.h"
 
 namespace rsvio {
@@ -120,6 +123,22 @@ inline std::vector<ImuSample> simulateImu(const AnalyticTrajectory& tr, double t
     out.push_back(s);
   }
   return out;
+}
+
+// A non-identity IMU-to-camera extrinsic T_Cm_I (a small rotation and a few cm, like the simulator's):
+// the camera looks forward (z) along the body x axis.
+inline SE3d defaultCameraFromImu() {
+  const SO3d R_i_c = SO3d(Mat3((Mat3() << 0, 0, 1, -1, 0, 0, 0, -1, 0).finished())) * SO3d::exp(Vec3(0.02, -0.03, 0.01));
+  const SE3d T_i_c(R_i_c, Vec3(0.05, -0.02, 0.03));
+  return T_i_c.inverse();
+}
+
+// An arbitrary free-scale world: 1 W_f unit = 2.5 m, tilted and turned.
+inline RxSO3d defaultMetricFromFree() { return RxSO3d(2.5, SO3d::exp(Vec3(0.3, -0.2, 0.8))); }
+
+// The non-metric camera pose T_Cf_Wf at time t of the analytic IMU trajectory.
+inline SE3d cameraPoseAt(const AnalyticTrajectory& tr, double t, const SE3d& T_cm_i, const RxSO3d& T_wm_wf) {
+  return cameraPoseFromImu(SE3d(tr.rotation(t), tr.position(t)), T_wm_wf, T_cm_i);
 }
 
 inline int64_t secToNs(double t) { return static_cast<int64_t>(std::llround(t * 1e9)); }
