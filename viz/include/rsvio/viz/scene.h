@@ -1,0 +1,43 @@
+// 3D views of a run, rendered off-screen with VTK to PNG.
+//
+// What is drawn (all in the ground truth's world when the snapshot has errors, i.e. the estimate is
+// mapped by the snapshot's alignment p_gt ~ s R p_est + t; otherwise in the estimate's own world):
+// - the estimated trajectory (every frame), coloured by position error with the turbo map (plain blue
+//   without ground truth), line width scaled with the image;
+// - the ground-truth trajectory (black);
+// - the sparse point cloud, grey levels from intensity (2nd..98th percentile stretched);
+// - keyframe frusta (camera poses: body poses are composed with T_B_C when the snapshot has it);
+// - a ground grid, a title (run, view, status, ATE), a legend, a colour bar for the error and, in the
+//   parallel top and side views, a scale bar.
+// Views: top (looking down -z, y up in the image), side (looking along +y, z up), perspective.
+// A snapshot without any geometry (a failed run) still gives each view: an image with the reason.
+//
+// Needs an X display: construct a viz::DisplayGuard first and check ok(). Throws rsvio::Error when VTK
+// cannot render or the PNG cannot be written.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "rsvio/io/snapshot.h"
+
+namespace rsvio::viz {
+
+enum class View { kTop, kSide, kPerspective };
+const char* viewName(View v);  // "top", "side", "perspective"
+
+struct SceneOptions {
+  int width = 1280;
+  int height = 960;
+  std::vector<View> views = {View::kTop, View::kSide, View::kPerspective};
+  bool show_points = true;
+  bool show_frusta = true;
+  bool show_ground_truth = true;
+  int max_frusta = 60;              // evenly subsampled beyond this
+  std::string file_prefix = "trajectory_";  // files are <out_dir>/<prefix><view>.png
+};
+
+// Renders every asked view; returns the written files in the order of options.views.
+std::vector<std::string> renderScenes(const io::Snapshot& snapshot, const SceneOptions& options,
+                                      const std::string& out_dir);
+
+}  // namespace rsvio::viz

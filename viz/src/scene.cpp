@@ -1,0 +1,422 @@
+// 3D views with VTK (scene.h). One off-screen window renders every view: the actors are built once,
+// then each view sets the camera and its own overlays and is read back into a PNG.
+#include "rsvio/viz/scene.h"
+
+#include <vtkActor.h>
+#include <vtkActor2D.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCommand.h>
+#include <vtkCoordinate.h>
+#include <vtkImageData.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataMapper2D.h>
+#include <vtkProperty.h>
+#include <vtkProperty2D.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "canvas.h"
+#include "rsvio/core/error.h"
+#include "rsvio/viz/colormap.h"
+#include "scene_geometry.h"
+
+namespace rsvio::viz {
+using detail::SceneGeometry;
+
+const char* viewName(View v) {
+  switch (v) {
+    case View::kTop: return "top";
+    case View::kSide: return "side";
+    case View::kPerspective: return "perspective";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kBg[3] = {1.0, 1.0, 1.0};
+constexpr Rgb kGtColour{20, 20, 20};
+constexpr Rgb kFrustumColour{150, 90, 200};
+constexpr Rgb kPlainEstimate{31, 119, 180};
+constexpr Rgb kGridColour{222, 222, 222};
+
+// Collects VTK error events so a failed render becomes an exception with VTK's own words.
+class ErrorObserver : public vtkCommand {
+ public:
+  static ErrorObserver* New() { return new ErrorObserver; }
+  void Execute(vtkObject*, unsigned long, void* data) override {
+    if (message_.empty() && data) message_ = static_cast<const char*>(data);
+  }
+  std::string message_;
+};
+
+void insertColour(vtkUnsignedCharArray* a, const Rgb& c) {
+  const unsigned char v[3] = {c.r, c.g, c.b};
+  a->InsertNextTypedTuple(v);
+}
+
+// Line actor from segments: pts pairs (a, b) with one colour per point.
+vtkSmartPointer<vtkActor> makeLines(const std::vector<Eigen::Vector3d>& pts, const std::vector<Rgb>& colours,
+                                    bool polyline, double width) {
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkUnsignedCharArray> rgb;
+  rgb->SetNumberOfComponents(3);
+  rgb->SetName("rgb");
+  for (size_t i = 0; i < pts.size(); ++i) {
+    points->InsertNextPoint(pts[i].x(), pts[i].y(), pts[i].z());
+    insertColour(rgb, colours[i]);
+  }
+  vtkNew<vtkCellArray> cells;
+  if (polyline) {
+    cells->InsertNextCell(static_cast<vtkIdType>(pts.size()));
+    for (size_t i = 0; i < pts.size(); ++i) cells->InsertCellPoint(static_cast<vtkIdType>(i));
+  } else {
+    for (size_t i = 0; i + 1 < pts.size(); i += 2) {
+      const vtkIdType ids[2] = {static_cast<vtkIdType>(i), static_cast<vtkIdType>(i + 1)};
+      cells->InsertNextCell(2, ids);
+    }
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(points);
+  pd->SetLines(cells);
+  pd->GetPointData()->SetScalars(rgb);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(pd);
+  mapper->SetColorModeToDirectScalars();
+  mapper->ScalarVisibilityOn();
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetLineWidth(static_cast<float>(width));
+  actor->GetProperty()->LightingOff();
+  return actor;
+}
+
+vtkSmartPointer<vtkActor> makePoints(const SceneGeometry& g, double size) {
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkUnsignedCharArray> rgb;
+  rgb->SetNumberOfComponents(3);
+  vtkNew<vtkCellArray> verts;
+  for (size_t i = 0; i < g.points.size(); ++i) {
+    points->InsertNextPoint(g.points[i].x(), g.points[i].y(), g.points[i].z());
+    // Bright points light grey, dark points dark grey: visible on white either way.
+    insertColour(rgb, grey(g.point_shade[i], 60, 200));
+    const vtkIdType id = static_cast<vtkIdType>(i);
+    verts->InsertNextCell(1, &id);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(points);
+  pd->SetVerts(verts);
+  pd->GetPointData()->SetScalars(rgb);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(pd);
+  mapper->SetColorModeToDirectScalars();
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetPointSize(static_cast<float>(size));
+  actor->GetProperty()->LightingOff();
+  return actor;
+}
+
+vtkSmartPointer<vtkActor> makeFrusta(const SceneGeometry& g, double width) {
+  std::vector<Eigen::Vector3d> seg;
+  const double d = g.frustum_size, w = 0.6 * d, h = 0.45 * d;
+  for (const auto& f : g.frusta) {
+    // Camera x right, y down, z forward: the image plane's corners at depth d.
+    const Eigen::Vector3d c[4] = {f.p_W_C + f.R_W_C * Eigen::Vector3d(-w, -h, d), f.p_W_C + f.R_W_C * Eigen::Vector3d(w, -h, d),
+                                  f.p_W_C + f.R_W_C * Eigen::Vector3d(w, h, d), f.p_W_C + f.R_W_C * Eigen::Vector3d(-w, h, d)};
+    for (int k = 0; k < 4; ++k) {
+      seg.push_back(f.p_W_C);
+      seg.push_back(c[k]);
+      seg.push_back(c[k]);
+      seg.push_back(c[(k + 1) % 4]);
+    }
+    // A tick on the top edge says which way is up in the image.
+    seg.push_back(0.5 * (c[0] + c[1]));
+    seg.push_back(0.5 * (c[0] + c[1]) + f.R_W_C * Eigen::Vector3d(0, -0.3 * h, 0));
+  }
+  return makeLines(seg, std::vector<Rgb>(seg.size(), kFrustumColour), false, width);
+}
+
+// Ground grid on the plane z = z0 spanning the bounds (xy), spacing a nice number.
+vtkSmartPointer<vtkActor> makeGrid(const Eigen::AlignedBox3d& b, double spacing, double z0) {
+  std::vector<Eigen::Vector3d> seg;
+  const double x0 = std::floor(b.min().x() / spacing) * spacing, x1 = std::ceil(b.max().x() / spacing) * spacing;
+  const double y0 = std::floor(b.min().y() / spacing) * spacing, y1 = std::ceil(b.max().y() / spacing) * spacing;
+  for (double x = x0; x <= x1 + 1e-9 * spacing; x += spacing) {
+    seg.emplace_back(x, y0, z0);
+    seg.emplace_back(x, y1, z0);
+  }
+  for (double y = y0; y <= y1 + 1e-9 * spacing; y += spacing) {
+    seg.emplace_back(x0, y, z0);
+    seg.emplace_back(x1, y, z0);
+  }
+  return makeLines(seg, std::vector<Rgb>(seg.size(), kGridColour), false, 1.0);
+}
+
+vtkSmartPointer<vtkTextActor> makeText(const std::string& s, int size, const Rgb& c, double x, double y, bool top,
+                                       bool right = false, bool centred = false) {
+  auto t = vtkSmartPointer<vtkTextActor>::New();
+  t->SetInput(s.c_str());
+  auto* p = t->GetTextProperty();
+  p->SetFontSize(size);
+  p->SetColor(c.r / 255.0, c.g / 255.0, c.b / 255.0);
+  p->SetFontFamilyToArial();
+  if (top) p->SetVerticalJustificationToTop();
+  else p->SetVerticalJustificationToBottom();
+  if (right) p->SetJustificationToRight();
+  if (centred) {
+    p->SetJustificationToCentered();
+    p->SetVerticalJustificationToCentered();
+  }
+  t->SetDisplayPosition(static_cast<int>(x), static_cast<int>(y));
+  return t;
+}
+
+// 2D polyline in viewport pixels (origin bottom left).
+vtkSmartPointer<vtkActor2D> make2DLine(const std::vector<Eigen::Vector2d>& pts, const Rgb& c, double width) {
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> cells;
+  cells->InsertNextCell(static_cast<vtkIdType>(pts.size()));
+  for (size_t i = 0; i < pts.size(); ++i) {
+    points->InsertNextPoint(pts[i].x(), pts[i].y(), 0);
+    cells->InsertCellPoint(static_cast<vtkIdType>(i));
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(points);
+  pd->SetLines(cells);
+  vtkNew<vtkCoordinate> coord;
+  coord->SetCoordinateSystemToViewport();
+  vtkNew<vtkPolyDataMapper2D> mapper;
+  mapper->SetInputData(pd);
+  mapper->SetTransformCoordinate(coord);
+  auto a = vtkSmartPointer<vtkActor2D>::New();
+  a->SetMapper(mapper);
+  a->GetProperty()->SetColor(c.r / 255.0, c.g / 255.0, c.b / 255.0);
+  a->GetProperty()->SetLineWidth(static_cast<float>(width));
+  return a;
+}
+
+std::string fmt(double v) { return detail::formatNumber(v); }
+
+void writePng(vtkRenderWindow* win, const std::string& path, int width, int height) {
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(win);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  vtkImageData* img = grab->GetOutput();
+  int dims[3];
+  img->GetDimensions(dims);
+  if (dims[0] != width || dims[1] != height) {
+    throw Error("VTK rendered " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + " instead of " +
+                std::to_string(width) + "x" + std::to_string(height));
+  }
+  cv::Mat rgb(height, width, CV_8UC3, img->GetScalarPointer());
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  cv::flip(bgr, bgr, 0);  // VTK's rows start at the bottom
+  if (!cv::imwrite(path, bgr)) throw Error(path + ": could not write PNG");
+}
+
+}  // namespace
+
+std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions& o, const std::string& out_dir) {
+  namespace fs = std::filesystem;
+  const SceneGeometry g = detail::buildSceneGeometry(s, o.show_points, o.show_frusta, o.show_ground_truth, o.max_frusta);
+  const int W = o.width, H = o.height;
+  const double px = std::max(1.0, std::min(W, H) / 480.0);  // line and point sizes grow with the image
+  const int font = static_cast<int>(std::clamp(std::min(W / 1.4, double(H)) / 40.0, 9.0, 24.0));
+  const bool coloured = !g.est_err.empty() && std::isfinite(g.est_err.front());
+
+  vtkNew<vtkRenderWindow> win;
+  win->SetOffScreenRendering(1);
+  win->SetSize(W, H);
+  win->SetMultiSamples(0);  // deterministic pixels; lines are wide enough without it
+  vtkNew<ErrorObserver> errors;
+  win->AddObserver(vtkCommand::ErrorEvent, errors);
+
+  // The scene on the left, the colour bar in a strip on the right of its own.
+  const double split = coloured ? 0.86 : 1.0;
+  vtkNew<vtkRenderer> scene;
+  scene->SetViewport(0, 0, split, 1);
+  scene->SetBackground(kBg[0], kBg[1], kBg[2]);
+  win->AddRenderer(scene);
+  vtkNew<vtkRenderer> side;
+  if (coloured) {
+    side->SetViewport(split, 0, 1, 1);
+    side->SetBackground(kBg[0], kBg[1], kBg[2]);
+    win->AddRenderer(side);
+  }
+  const double sw = W * split;  // scene viewport width in pixels
+
+  std::string status = "status " + s.summary.status;
+  if (std::isfinite(s.summary.ate_rmse_m)) status += ", ATE " + fmt(s.summary.ate_rmse_m) + " m (report)";
+  else if (s.errors) status += ", ATE " + fmt(s.errors->ate_m.rmse) + " m";
+  if (!g.empty()) status += ", " + g.align_label;
+
+  if (!g.empty()) {
+    if (!g.gt.empty()) scene->AddActor(makeLines(g.gt, std::vector<Rgb>(g.gt.size(), kGtColour), true, 1.5 * px));
+    if (!g.points.empty()) scene->AddActor(makePoints(g, std::max(1.0, 1.5 * px)));
+    if (!g.frusta.empty()) scene->AddActor(makeFrusta(g, std::max(1.0, 0.75 * px)));
+    if (!g.est.empty()) {
+      std::vector<Rgb> col(g.est.size(), kPlainEstimate);
+      if (coloured) {
+        for (size_t i = 0; i < g.est.size(); ++i) col[i] = turbo(g.est_err[i] / g.err_max);
+      }
+      scene->AddActor(makeLines(g.est, col, true, 2.5 * px));
+    }
+    if (coloured) {
+      vtkNew<vtkLookupTable> lut;
+      lut->SetNumberOfTableValues(256);
+      lut->SetRange(0, g.err_max);
+      for (int i = 0; i < 256; ++i) {
+        const Rgb c = turbo(i / 255.0);
+        lut->SetTableValue(i, c.r / 255.0, c.g / 255.0, c.b / 255.0, 1.0);
+      }
+      lut->Build();
+      vtkNew<vtkScalarBarActor> bar;
+      bar->SetLookupTable(lut);
+      bar->SetTitle("error [m]");
+      bar->SetNumberOfLabels(5);
+      bar->SetLabelFormat("%-#6.3g");
+      bar->UnconstrainedFontSizeOn();
+      bar->GetTitleTextProperty()->SetFontSize(font);
+      bar->GetLabelTextProperty()->SetFontSize(static_cast<int>(font * 0.85));
+      for (auto* tp : {bar->GetTitleTextProperty(), bar->GetLabelTextProperty()}) {
+        tp->SetColor(0.1, 0.1, 0.1);
+        tp->ShadowOff();
+        tp->ItalicOff();
+        tp->BoldOff();
+      }
+      bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+      bar->GetPositionCoordinate()->SetValue(0.05, 0.12);
+      bar->GetPosition2Coordinate()->SetValue(0.9, 0.76);
+      bar->SetBarRatio(0.3);
+      side->AddActor2D(bar);
+    }
+    // Legend, bottom left: a short line of each colour and its meaning.
+    struct Entry {
+      std::string text;
+      Rgb colour;
+    };
+    std::vector<Entry> legend;
+    if (!g.est.empty()) legend.push_back({coloured ? "estimate (colour = error)" : "estimate", coloured ? turbo(0.15) : kPlainEstimate});
+    if (!g.gt.empty()) legend.push_back({"ground truth", kGtColour});
+    if (!g.points.empty()) legend.push_back({"points (grey = intensity)", Rgb{120, 120, 120}});
+    if (!g.frusta.empty()) legend.push_back({"keyframes", kFrustumColour});
+    const double row = font * 1.35, x0 = font * 0.8;
+    for (size_t i = 0; i < legend.size(); ++i) {
+      const double y = font * 0.8 + row * (legend.size() - 1 - i) + row * 0.5;
+      scene->AddActor2D(make2DLine({{x0, y}, {x0 + font * 1.6, y}}, legend[i].colour, 3 * px));
+      scene->AddActor2D(makeText(legend[i].text, static_cast<int>(font * 0.85), Rgb{30, 30, 30}, x0 + font * 2.1,
+                                 y - font * 0.45, false));
+    }
+  } else {
+    scene->AddActor2D(makeText(g.message, font, Rgb{200, 30, 30}, sw / 2, H / 2.0, false, false, true));
+  }
+
+  const Eigen::AlignedBox3d bounds = g.bounds.isEmpty() ? Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1))
+                                                        : g.bounds;
+  const Eigen::Vector3d c = bounds.center(), ext = bounds.sizes();
+  const double extent = std::max(1e-3, ext.maxCoeff());
+  const double spacing = detail::niceNumber(extent / 8.0);
+  vtkSmartPointer<vtkActor> grid;
+  if (!g.empty()) {
+    grid = makeGrid(bounds, spacing, bounds.min().z() - 0.02 * extent);
+    scene->AddActor(grid);
+  }
+
+  fs::create_directories(out_dir);
+  std::vector<std::string> files;
+  for (View v : o.views) {
+    std::vector<vtkSmartPointer<vtkProp>> overlays;  // removed again after this view
+    auto overlay = [&](vtkSmartPointer<vtkProp> p) {
+      scene->AddViewProp(p);
+      overlays.push_back(p);
+    };
+    vtkCamera* cam = scene->GetActiveCamera();
+    const double aspect = sw / H;
+    // Fraction of the height kept clear for the title (top) and the legend (bottom).
+    const double vmargin = 1.45, hmargin = 1.12;
+    double eh = 0, ew = 0;  // world extents seen vertically / horizontally
+    if (v == View::kTop) {
+      cam->SetFocalPoint(c.x(), c.y(), c.z());
+      cam->SetPosition(c.x(), c.y(), c.z() + 10 * extent);
+      cam->SetViewUp(0, 1, 0);
+      cam->ParallelProjectionOn();
+      ew = ext.x();
+      eh = ext.y();
+    } else if (v == View::kSide) {
+      cam->SetFocalPoint(c.x(), c.y(), c.z());
+      cam->SetPosition(c.x(), c.y() - 10 * extent, c.z());
+      cam->SetViewUp(0, 0, 1);
+      cam->ParallelProjectionOn();
+      ew = ext.x();
+      eh = ext.z();
+    } else {
+      const Eigen::Vector3d dir = Eigen::Vector3d(0.55, -1.0, 0.75).normalized();
+      cam->SetFocalPoint(c.x(), c.y(), c.z());
+      cam->SetPosition(c.x() + dir.x() * 10 * extent, c.y() + dir.y() * 10 * extent, c.z() + dir.z() * 10 * extent);
+      cam->SetViewUp(0, 0, 1);
+      cam->ParallelProjectionOff();
+      cam->SetViewAngle(30);
+      scene->ResetCamera(bounds.min().x(), bounds.max().x(), bounds.min().y(), bounds.max().y(), bounds.min().z(),
+                         bounds.max().z());
+      cam->Zoom(1.15);
+    }
+    double half_h = 0;
+    if (v != View::kPerspective) {
+      half_h = std::max({0.5 * eh * vmargin, 0.5 * ew * hmargin / aspect, 1e-3});
+      cam->SetParallelScale(half_h);
+    }
+    scene->ResetCameraClippingRange();
+
+    std::string title = s.name + ": " + viewName(v) + " view";
+    if (v == View::kTop) title += " (x right, y up)";
+    if (v == View::kSide) title += " (x right, z up)";
+    overlay(makeText(title, font, Rgb{20, 20, 20}, font * 0.6, H - font * 0.5, true));
+    overlay(makeText(status, static_cast<int>(font * 0.8), Rgb{90, 90, 90}, font * 0.6, H - font * 2.0, true));
+    if (!g.empty()) {
+      std::string grid_note = "grid " + fmt(spacing) + " " + g.unit;
+      if (v != View::kPerspective) {
+        // Scale bar: a nice length near a fifth of the view's width, bottom right.
+        const double px_per_unit = H / (2.0 * half_h);
+        const double len = detail::niceNumber(0.2 * sw / px_per_unit);
+        const double len_px = len * px_per_unit, xr = sw - font * 1.2, yb = font * 1.4;
+        overlay(make2DLine({{xr - len_px, yb + font * 0.3}, {xr - len_px, yb}, {xr, yb}, {xr, yb + font * 0.3}}, Rgb{20, 20, 20},
+                           2 * px));
+        overlay(makeText(fmt(len) + " " + g.unit, static_cast<int>(font * 0.85), Rgb{20, 20, 20}, xr - len_px / 2, yb + font * 0.4,
+                         false, false, false));
+        static_cast<vtkTextActor*>(overlays.back().Get())->GetTextProperty()->SetJustificationToCentered();
+      }
+      overlay(makeText(grid_note, static_cast<int>(font * 0.75), Rgb{120, 120, 120}, sw - font * 1.2, H - font * 0.5, true, true));
+    }
+    win->Render();
+    if (!errors->message_.empty()) throw Error("VTK could not render: " + errors->message_);
+    const std::string path = (fs::path(out_dir) / (o.file_prefix + viewName(v) + ".png")).string();
+    writePng(win, path, W, H);
+    if (!errors->message_.empty()) throw Error("VTK could not read back the image: " + errors->message_);
+    files.push_back(path);
+    for (auto& p : overlays) scene->RemoveViewProp(p);
+  }
+  return files;
+}
+
+}  // namespace rsvio::viz
