@@ -24,9 +24,10 @@ namespace rsvio {
 namespace test {
 
 struct Sinusoid {
-  double offset = 0.0, amplitude = 0.0, freq = 0.0, phase = 0.0;  // value = offset + amp sin(freq t + phase)
-  double value(double t) const { return offset + amplitude * std::sin(freq * t + phase); }
-  double rate(double t) const { return amplitude * freq * std::cos(freq * t + phase); }
+  // value = offset + amp sin(freq t + phase) + slope t
+  double offset = 0.0, amplitude = 0.0, freq = 0.0, phase = 0.0, slope = 0.0;
+  double value(double t) const { return offset + amplitude * std::sin(freq * t + phase) + slope * t; }
+  double rate(double t) const { return amplitude * freq * std::cos(freq * t + phase) + slope; }
   double accel(double t) const { return -amplitude * freq * freq * std::sin(freq * t + phase); }
 };
 
