@@ -73,7 +73,8 @@ class PinholeModel {
   template <Distortion D>
   bool project(const Vec3& p_c, Vec2& uv, Mat23* d_uv_d_p) const {
     const Scalar z = p_c.z();
-    if (!(z >= min_depth_)) return false;  // also false for NaN
+    using std::isfinite;
+    if (!(z >= min_depth_) || !isfinite(z) || !isfinite(p_c.x()) || !isfinite(p_c.y())) return false;
     const Scalar inv_z = Scalar(1) / z;
     const Vec2 xn(p_c.x() * inv_z, p_c.y() * inv_z);
     Vec2 xd;

@@ -125,6 +125,23 @@ TEST(BadInput, WindowsLineEndingsAndByteOrderMarkAreAccepted) {
   EXPECT_EQ(src->numFrames(), 5u);
 }
 
+TEST(BadInput, HeaderWithoutHashIsSkippedWithAWarning) {
+  TempDir tmp;
+  writeDataset(tmp.path(), DatasetSpec());
+  replaceInFile(camCsv(tmp.path()), "#timestamp [ns],filename", "timestamp,filename");
+  auto src = opened(tmp.path());
+  EXPECT_EQ(src->numFrames(), 5u);
+  EXPECT_TRUE(anyContains(src->warnings(), camCsv(tmp.path()).string() + ":1: no field is a number; taken as a column header"))
+      << joined(src->warnings());
+}
+
+TEST(BadInput, CorruptFirstImuRowIsNotMistakenForAHeader) {
+  TempDir tmp;
+  writeDataset(tmp.path(), DatasetSpec());
+  writeText(imuCsv(tmp.path()), "x" + imuLine(0) + imuLines(1, kImuCount));
+  EXPECT_HAS(fatal(tmp.path()), imuCsv(tmp.path()).string() + ":1:1: field 'timestamp [ns]': expected an integer");
+}
+
 TEST(BadInput, EmptyImageIndexIsFatal) {
   TempDir tmp;
   writeDataset(tmp.path(), DatasetSpec());

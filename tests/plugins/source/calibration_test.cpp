@@ -81,6 +81,21 @@ TEST(BadCalibration, WrongDistortionCoefficientCount) {
   EXPECT_HAS(fatal(tmp.path()), "key 'distortion_coefficients': expected 4 numbers [k1, k2, p1, p2], found 3");
 }
 
+TEST(BadCalibration, DistortionNoneAcceptsZeroPaddingOnly) {
+  TempDir tmp;
+  datasetWithYamlEdit(tmp, "distortion_model: radial-tangential\ndistortion_coefficients: [-0.28340811",
+                      "distortion_model: none\ndistortion_coefficients: [0.0");
+  EXPECT_HAS(fatal(tmp.path()), "key 'distortion_coefficients': non-zero coefficients with distortion model 'none'");
+  TempDir tmp2;
+  datasetWithYamlEdit(tmp2, "distortion_coefficients: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]",
+                      "distortion_coefficients: [0, 0, 0, 0]");
+  replaceInFile(tmp2.path() / "mav0" / "cam0" / "sensor.yaml", "radial-tangential", "none");
+  auto src = makeSource();
+  ASSERT_EQ(openError(*src, tmp2.path()), "");
+  EXPECT_EQ(src->sensors().camera.distortion, "none");
+  EXPECT_EQ(src->sensors().camera.distortion_coeffs.size(), 0);
+}
+
 TEST(BadCalibration, ExtrinsicThatIsNotARotation) {
   TempDir tmp;
   datasetWithYamlEdit(tmp, "data: [0.0148655429818,", "data: [0.5148655429818,");

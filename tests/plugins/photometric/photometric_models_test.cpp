@@ -1,0 +1,187 @@
+// photometric.affine, photometric.vignette and photometric.response: corrections with a calibration,
+// online parameters and their derivatives without one, errors naming the slot or file, and loading
+// through the plugin host.
+#include <gtest/gtest.h>
+
+#include "plugins/photometric/response/response_model.h"
+#include "plugins/photometric/vignette/vignette_model.h"
+#include "rsvio/config/validate.h"
+#include "rsvio/plugin/host.h"
+#include "support/numeric_jacobian.h"
+
+namespace rsvio {
+namespace {
+
+SensorSetup sensors(int w = 40, int h = 30) {
+  SensorSetup s;
+  s.camera.width = w;
+  s.camera.height = h;
+  s.camera.intrinsics << 30, 30, 19.5, 14.5;
+  return s;
+}
+
+Frame frame() {
+  Frame f;
+  f.index = 1;
+  return f;
+}
+
+TEST(VignetteModel, CalibratedDividesByTheVignette) {
+  SensorSetup s = sensors();
+  s.photometric.vignette = cv::Mat(30, 40, CV_32F, cv::Scalar(0.5));
+  s.photometric.vignette.at<float>(3, 4) = 0.01f;  // clamped to min_value
+  VignetteModel m(VignetteModel::Mode::Auto, 0.05, Eigen::Vector3d::Zero());
+  m.setSensors(s);
+  EXPECT_TRUE(m.isCalibrated());
+  EXPECT_EQ(m.numParams(), 0);
+  cv::Mat img(30, 40, CV_32F, cv::Scalar(60.0));
+  m.correct(img, frame());
+  EXPECT_FLOAT_EQ(img.at<float>(10, 10), 120.f);
+  EXPECT_FLOAT_EQ(img.at<float>(3, 4), 60.f / 0.05f);
+  double dv = 0;
+  EXPECT_DOUBLE_EQ(m.predict(7.0, Vec2(1, 2), &dv, nullptr), 7.0);
+  EXPECT_DOUBLE_EQ(dv, 1.0);
+}
+
+TEST(VignetteModel, EstimatedPolynomialAndItsDerivatives) {
+  VignetteModel m(VignetteModel::Mode::Auto, 0.05, Eigen::Vector3d(-0.3, 0.1, -0.05));
+  m.setSensors(sensors());
+  EXPECT_FALSE(m.isCalibrated());
+  ASSERT_EQ(m.numParams(), 3);
+  EXPECT_DOUBLE_EQ(m.radius(Vec2(19.5, 14.5)), 0.0);
+  EXPECT_DOUBLE_EQ(m.radius(Vec2(0, 0)), 1.0);  // farthest corner
+  cv::Mat img(30, 40, CV_32F, cv::Scalar(60.0));
+  m.correct(img, frame());
+  EXPECT_FLOAT_EQ(img.at<float>(0, 0), 60.f);  // estimated: images untouched
+  const Vec2 uv(5.0, 27.0);
+  const double value = 80.0;
+  double d_value = 0;
+  Eigen::VectorXd d_params;
+  const double out = m.predict(value, uv, &d_value, &d_params);
+  const double r = m.radius(uv);
+  EXPECT_NEAR(out, value * (1 - 0.3 * r * r + 0.1 * std::pow(r, 4) - 0.05 * std::pow(r, 6)), 1e-12);
+  const Eigen::MatrixXd num_p = test::numericJacobian(
+      [&](const Eigen::VectorXd& p) {
+        VignetteModel mm = m;
+        mm.setParams(p);
+        return mm.predict(value, uv, nullptr, nullptr);
+      },
+      Eigen::VectorXd(m.params()), test::vectorPlus, 3);
+  EXPECT_JACOBIAN_NEAR(d_params.transpose(), num_p, 1e-7);
+  const Eigen::MatrixXd num_v =
+      test::numericJacobian([&](double x) { return m.predict(x, uv, nullptr, nullptr); }, value, test::vectorPlus, 1);
+  EXPECT_NEAR(d_value, num_v(0, 0), 1e-7);
+}
+
+TEST(VignetteModel, ErrorsNameTheSlotAndFile) {
+  VignetteModel m(VignetteModel::Mode::Calibrated, 0.05, Eigen::Vector3d::Zero(), "photometric.vig");
+  try {
+    m.setSensors(sensors());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("photometric.vig.params.mode"), std::string::npos) << e.what();
+  }
+  SensorSetup s = sensors();
+  s.photometric.vignette = cv::Mat(10, 10, CV_32F, cv::Scalar(1.0));
+  s.photometric.vignette_path = "/data/vignette.png";
+  try {
+    m.setSensors(s);
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("/data/vignette.png"), std::string::npos) << e.what();
+  }
+  VignetteModel est(VignetteModel::Mode::Estimate, 0.05, Eigen::Vector3d::Zero());
+  s.photometric.vignette = cv::Mat(30, 40, CV_32F, cv::Scalar(0.5));
+  est.setSensors(s);
+  EXPECT_FALSE(est.isCalibrated());  // "estimate" ignores the file on purpose
+}
+
+TEST(ResponseModel, CalibratedInverseResponseIsRescaledAndInterpolated) {
+  SensorSetup s = sensors();
+  s.photometric.inverse_response.resize(256);
+  for (int i = 0; i < 256; ++i) s.photometric.inverse_response[i] = 10.f + 2.f * i * i / 255.f;  // convex
+  ResponseModel m(ResponseModel::Mode::Auto, 1.0);
+  m.setSensors(s);
+  ASSERT_TRUE(m.isCalibrated());
+  EXPECT_FLOAT_EQ(m.inverse(0.f), 0.f);
+  EXPECT_FLOAT_EQ(m.inverse(255.f), 255.f);
+  EXPECT_NEAR(m.inverse(100.f), 255.f * 100.f * 100.f / (255.f * 255.f), 1e-3);
+  EXPECT_NEAR(m.inverse(100.5f), 0.5f * (m.inverse(100.f) + m.inverse(101.f)), 1e-4);
+  cv::Mat img(30, 40, CV_32F, cv::Scalar(100.0));
+  m.correct(img, frame());
+  EXPECT_FLOAT_EQ(img.at<float>(5, 5), m.inverse(100.f));
+  EXPECT_EQ(m.numParams(), 0);
+}
+
+TEST(ResponseModel, EstimatedGammaAndItsDerivatives) {
+  ResponseModel m(ResponseModel::Mode::Auto, 1.0);
+  m.setSensors(sensors());
+  ASSERT_EQ(m.numParams(), 1);
+  Eigen::VectorXd g(1);
+  g << 0.6;
+  m.setParams(g);
+  const double B = 90.0;
+  double d_value = 0;
+  Eigen::VectorXd d_params;
+  const double I = m.predict(B, Vec2(3, 3), &d_value, &d_params);
+  EXPECT_NEAR(I, 255.0 * std::pow(B / 255.0, 0.6), 1e-12);
+  const Eigen::MatrixXd num_g = test::numericJacobian(
+      [&](const Eigen::VectorXd& p) {
+        ResponseModel mm = m;
+        mm.setParams(p);
+        return mm.predict(B, Vec2(3, 3), nullptr, nullptr);
+      },
+      Eigen::VectorXd(m.params()), test::vectorPlus, 1);
+  EXPECT_JACOBIAN_NEAR(d_params.transpose(), num_g, 1e-7);
+  const Eigen::MatrixXd num_v =
+      test::numericJacobian([&](double x) { return m.predict(x, Vec2(3, 3), nullptr, nullptr); }, B, test::vectorPlus, 1);
+  EXPECT_NEAR(d_value, num_v(0, 0), 1e-7);
+  EXPECT_THROW(m.setParams(Eigen::VectorXd::Zero(1)), Error);
+}
+
+TEST(ResponseModel, BadCalibrationIsADataError) {
+  SensorSetup s = sensors();
+  s.photometric.inverse_response.assign(100, 1.f);
+  s.photometric.response_path = "/data/pcalib.txt";
+  ResponseModel m(ResponseModel::Mode::Auto, 1.0);
+  try {
+    m.setSensors(s);
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("/data/pcalib.txt"), std::string::npos);
+  }
+  ResponseModel c(ResponseModel::Mode::Calibrated, 1.0);
+  EXPECT_THROW(c.setSensors(sensors()), ConfigError);
+}
+
+Params defaults(PluginHost& host, const std::string& name, const nlohmann::json& given = nlohmann::json::object()) {
+  std::vector<ConfigProblem> problems;
+  auto p = validateParams(given, host.info(name).params, "photometric.x.params", problems);
+  EXPECT_TRUE(problems.empty());
+  return Params(p, "photometric.x");
+}
+
+TEST(PhotometricPlugins, LoadThroughTheHost) {
+  PluginHost host({RSVIO_PLUGIN_DIR});
+  auto affine = host.create<PhotometricModel>("photometric.affine", defaults(host, "photometric.affine"));
+  EXPECT_TRUE(affine->hasAffineBrightness());
+  EXPECT_DOUBLE_EQ(affine->affinePriorA(), 0.0);
+  auto affine2 = host.create<PhotometricModel>("photometric.affine",
+                                               defaults(host, "photometric.affine", {{"prior_a", 1e12}}));
+  EXPECT_DOUBLE_EQ(affine2->affinePriorA(), 1e12);
+  auto vig = host.create<PhotometricModel>("photometric.vignette", defaults(host, "photometric.vignette"));
+  vig->setSensors(sensors());
+  EXPECT_FALSE(vig->hasAffineBrightness());
+  EXPECT_EQ(vig->numParams(), 3);
+  auto resp = host.create<PhotometricModel>("photometric.response",
+                                            defaults(host, "photometric.response", {{"mode", "calibrated"}}));
+  try {
+    resp->setSensors(sensors());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("photometric.x.params.mode"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace rsvio
