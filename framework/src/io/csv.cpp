@@ -118,7 +118,11 @@ bool CsvReader::next() {
     split(text);
     if (first_data_row_) {
       first_data_row_ = false;
-      if (format_.skip_text_header && !values_.empty() && !parseDouble(values_[0])) continue;
+      if (format_.skip_text_header &&
+          std::none_of(values_.begin(), values_.end(), [](const std::string& v) { return parseDouble(v).has_value(); })) {
+        header_line_ = line_;
+        continue;
+      }
     }
     return true;
   }

@@ -145,13 +145,16 @@ void readDistortion(const std::string& path, const YAML::Node& cam, const std::s
     return;
   }
   c.distortion = distortionName(path, model, model_key);
-  const int n = c.distortion == "none" ? 0 : 4;
-  const std::string names = c.distortion == "radtan" ? "[k1, k2, p1, p2]" : c.distortion == "equidistant" ? "[k1, k2, k3, k4]" : "[]";
-  if (n == 0 && (!coeffs.IsDefined() || coeffs.IsNull())) {
+  if (c.distortion == "none") {
+    // Writers often pad "none" with zeros; any non-zero coefficient contradicts the model name.
+    if (coeffs.IsDefined() && !coeffs.IsNull())
+      for (double k : toDoubles(path, coeffs, coeff_key, -1, "[]"))
+        if (k != 0.0) throw keyError(path, coeffs, coeff_key, "non-zero coefficients with distortion model 'none'");
     c.distortion_coeffs.resize(0);
     return;
   }
-  const auto v = toDoubles(path, require(path, cam, coeff_key, ""), coeff_key, n, names);
+  const std::string names = c.distortion == "radtan" ? "[k1, k2, p1, p2]" : "[k1, k2, k3, k4]";
+  const auto v = toDoubles(path, require(path, cam, coeff_key, ""), coeff_key, 4, names);
   c.distortion_coeffs = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 

@@ -36,6 +36,13 @@ std::string truncatedMessage(const io::CsvReader& csv, size_t want, const std::s
          " of " + std::to_string(want) + " fields, no newline at the end of the file); " + what + " dropped";
 }
 
+// A header without '#' is fine, but say so: were it a corrupt first row, it would vanish silently.
+void noteHeader(const io::CsvReader& csv, std::vector<std::string>& warnings) {
+  if (csv.skippedHeaderLine() > 0)
+    warnings.push_back(csv.path() + ":" + std::to_string(csv.skippedHeaderLine()) +
+                       ": no field is a number; taken as a column header and skipped");
+}
+
 }  // namespace
 
 std::vector<CameraIndexEntry> readCameraIndex(const std::string& csv_path, std::vector<std::string>& warnings) {
@@ -75,6 +82,7 @@ std::vector<CameraIndexEntry> readCameraIndex(const std::string& csv_path, std::
     out.push_back(std::move(e));
   }
   dup.finish();
+  noteHeader(csv, warnings);
   if (out.empty()) throw DataError::at(csv_path, 0, "no frames listed (expected lines \"<timestamp [ns]>,<file>\")");
   return out;
 }
@@ -131,6 +139,7 @@ ImuReadResult readImuCsv(const std::string& csv_path, std::vector<std::string>& 
   }
   nonfinite.finish();
   dup.finish();
+  noteHeader(csv, warnings);
   return out;
 }
 

@@ -5,8 +5,9 @@
 // Contract
 // - Lines end in "\n" or "\r\n"; a UTF-8 byte-order mark at the start is skipped. Blank lines and lines
 //   whose first non-blank character is the comment character ('#') are skipped: EuRoC's header line
-//   "#timestamp [ns],filename" is such a comment. With skip_text_header, a first data row whose first
-//   field is not a number is taken as a header without '#' and skipped too.
+//   "#timestamp [ns],filename" is such a comment. With skip_text_header, a first data row in which no
+//   field is a number is taken as a header without '#' and skipped too; skippedHeaderLine() tells which
+//   line that was, so a reader can say so (a corrupt first row must not vanish silently).
 // - Fields are split on the delimiter (',') or on runs of blanks (Delimiter::kWhitespace); blanks around
 //   a field are trimmed. There is no quoting: none of the formats rsvio reads quote.
 // - Lines and columns are 1-based; a field's column is the column of its first character (of the place
@@ -34,7 +35,7 @@ struct CsvFormat {
   enum class Delimiter { kComma, kWhitespace };
   Delimiter delimiter = Delimiter::kComma;
   char comment = '#';
-  bool skip_text_header = false;  // skip a first data row whose first field is not a number
+  bool skip_text_header = false;  // skip a first data row in which no field is a number
 };
 
 class CsvReader {
@@ -51,6 +52,7 @@ class CsvReader {
   size_t size() const { return values_.size(); }
   bool rowUnterminated() const { return unterminated_; }
   const std::vector<std::string>& fieldNames() const { return names_; }
+  long skippedHeaderLine() const { return header_line_; }  // 0 when no header row was skipped
 
   const std::string& raw(size_t i) const;  // field text, trimmed ("" beyond the row's fields)
   int column(size_t i) const;              // 1-based column of field i
@@ -80,6 +82,7 @@ class CsvReader {
   std::ifstream in_;
   long line_ = 0;
   bool first_data_row_ = true;
+  long header_line_ = 0;
   bool unterminated_ = false;
   std::vector<std::string> values_;
   std::vector<int> columns_;
