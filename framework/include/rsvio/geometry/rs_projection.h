@@ -1,0 +1,113 @@
+// Rolling-shutter projection (paper sec. IV-A, eqs. 6-7): where a 3D point appears in a target frame
+// whose pose moves during the readout, and the Jacobians of that pixel w.r.t. the state.
+//
+// Contract
+// - Target frame: central pose T_c_w^0 (world -> camera, at the image timestamp, i.e. raw row y0) and
+//   twist xi = (translation; rotation) per second, left: T_c_w(t) = exp(xi t) T_c_w^0 (eq. 6).
+// - Raw row v is read at t(v) = dt_dv (v - y0), dt_dv = direction * line_delay_s (RowTiming;
+//   conventions.md "Time"). Rows are raw (distorted) rows: the camera projects through its distortion,
+//   so the row IS f_d of eq. 7 and no undistorted image is needed.
+// - The projection solves the rolling-shutter constraint  v = project(T_c_w(t(v)) X_w).v  for v by
+//   Newton's method on the row (at most max_iterations evaluations; converged flag; never loops).
+//   A global shutter (dt_dv = 0) takes the same code path and stops after one evaluation.
+// - Jacobians are total derivatives of uv at the solution, including the implicit dependence of the
+//   row on the state (implicit function theorem, derivation in docs/rs_projection.md):
+//     d uv / d s = M * (d project / d s at fixed row),   M = (I - a e_v^T)^-1,
+//     a = d project / d v at fixed state = J_cam * (d p / d t) * dt_dv,  e_v = (0, 1)^T.
+//   Poses use the optimiser's LEFT perturbation T <- exp(delta) T (rsvio/lie/lie.h); twists are
+//   perturbed additively (xi <- xi + d); the line delay additively in seconds.
+// - Validity: the camera says valid (in front, inside its domain), the iteration converged, and
+//   1 - a_y is not near 0 (a point moving down the image as fast as the readout has no unique row).
+//   Whether the pixel lies inside the image is the caller's test (CameraModel::inImage).
+// - Host-frame points (DSO's parametrisation): bearing b in host camera h, observed at host raw row v_h,
+//   inverse depth rho > 0: X_w = T_h_w(t_h)^-1 (b / rho), T_h_w(t) = exp(xi_h t) T_h_w^0, t_h = t(v_h).
+//   Host and target are frames of the same camera (one RowTiming); d uv / d line_delay includes the
+//   host's row time.
+// - Batch calls: one call per host-target pair; each Newton iteration is one camera batch call.
+#pragma once
+#include <Eigen/Core>
+#include <vector>
+
+#include "rsvio/core/types.h"
+#include "rsvio/lie/se3.h"
+
+namespace rsvio {
+
+class CameraModel;
+class ShutterModel;
+
+using Mat26 = Eigen::Matrix<double, 2, 6>;
+
+// When each raw row is read: t(v) = direction * line_delay_s * (v - y0).
+struct RowTiming {
+  double y0 = 0.0;            // raw row of the image timestamp, (h - 1) / 2
+  double line_delay_s = 0.0;  // s per row (>= 0 in practice; any value works for the derivatives)
+  double direction = 0.0;     // +1 top_down, -1 bottom_up, 0 global shutter
+
+  double dtDv() const { return direction * line_delay_s; }
+  double rowTime(double v) const { return dtDv() * (v - y0); }
+  double dRowTimeDLineDelay(double v) const { return direction * (v - y0); }
+
+  static RowTiming global(double y0) { return RowTiming{y0, 0.0, 0.0}; }
+  static RowTiming rolling(double y0, double line_delay_s, bool top_down) {
+    return RowTiming{y0, line_delay_s, top_down ? 1.0 : -1.0};
+  }
+  // From the plugins: y0 from the camera's calibration; the direction from the sign of
+  // rowTimeDerivative(). A rolling shutter whose line delay is exactly 0 reports no sign and is taken
+  // as top_down (then only d uv / d line_delay would have the wrong sign).
+  static RowTiming from(const ShutterModel& shutter, const CameraModel& camera);
+};
+
+struct RsProjectionOptions {
+  int max_iterations = 10;     // camera evaluations per point, at most
+  double tolerance_px = 1e-6;  // |project(T(t(v)) X).v - v| at convergence
+  double min_singular = 1e-3;  // |1 - a_y| below this: no unique row, invalid
+  bool jacobians = true;
+};
+
+// One target frame: central pose and twist (eq. 6).
+struct RsFrame {
+  SE3d T_c_w0;
+  Vec6 xi = Vec6::Zero();  // per second, (translation; rotation)
+};
+
+// A world point projected into the target.
+struct RsProjection {
+  Vec2 uv = Vec2::Zero();
+  double t_s = 0.0;         // row time of the solution, relative to the target's timestamp
+  bool valid = false;
+  bool converged = false;
+  int iterations = 0;       // camera evaluations used
+  Mat26 d_uv_d_T0 = Mat26::Zero();   // left perturbation of T_c_w^0
+  Mat26 d_uv_d_xi = Mat26::Zero();   // target twist
+  Eigen::Matrix<double, 2, 3> d_uv_d_X = Eigen::Matrix<double, 2, 3>::Zero();  // world point
+  Vec2 d_uv_d_line_delay = Vec2::Zero();  // per second of line delay
+};
+
+// A host-frame point projected into the target: the world-point fields, plus the host's.
+struct RsHostProjection : RsProjection {
+  Mat26 d_uv_d_Th0 = Mat26::Zero();  // left perturbation of the host's T_h_w^0
+  Mat26 d_uv_d_xi_h = Mat26::Zero(); // host twist
+  Vec2 d_uv_d_idepth = Vec2::Zero(); // inverse depth rho
+  // d_uv_d_line_delay here is total: target row time and host row time t_h = t(v_h).
+};
+
+// World points X_w (3xN) into the target frame. out is resized to N.
+void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& target,
+                           const Eigen::Matrix3Xd& X_w, std::vector<RsProjection>& out,
+                           const RsProjectionOptions& options = {});
+
+// Host points (unit bearings 3xN at host raw rows v_h, inverse depths rho) into the target frame.
+void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
+                           const RsFrame& target, const Eigen::Matrix3Xd& bearing_h,
+                           const Eigen::VectorXd& v_h, const Eigen::VectorXd& idepth,
+                           std::vector<RsHostProjection>& out, const RsProjectionOptions& options = {});
+
+// Single-point versions (not for hot loops).
+RsProjection projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& target,
+                                   const Vec3& X_w, const RsProjectionOptions& options = {});
+RsHostProjection projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
+                                       const RsFrame& target, const Vec3& bearing_h, double v_h, double idepth,
+                                       const RsProjectionOptions& options = {});
+
+}  // namespace rsvio

@@ -1,0 +1,162 @@
+// Rolling-shutter projection of host-frame points (bearing, host row, inverse depth): agreement with
+// the world-point form, Jacobians w.r.t. host pose, host twist, inverse depth and the (shared) line
+// delay against numeric differences, the batch API, and RowTiming from the shutter plugins.
+#include <gtest/gtest.h>
+
+#include "rsvio/geometry/rs_projection.h"
+#include "support/numeric_jacobian.h"
+#include "support/plugin_contracts.h"
+
+namespace rsvio::test {
+namespace {
+
+class RsHostProjectionTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    CameraCalibration c = defaultContractCalibration();
+    c.distortion = "equidistant";
+    c.intrinsics = Eigen::Vector4d(160.0, 161.0, 159.5, 127.5);
+    c.distortion_coeffs = Eigen::Vector4d(0.0035, 0.0067, -0.0087, 0.0029);
+    cam_ = makePlugin<CameraModel>("camera.pinhole");
+    cam_->setCalibration(c);
+    timing_ = RowTiming::rolling(c.rowZero(), 4e-5, true);
+    target_.T_c_w0 = SE3d(SO3d::exp(Vec3(0.1, -0.2, 0.05)), Vec3(0.3, -0.1, 0.2));
+    target_.xi << 0.8, -0.3, 0.5, 0.6, -1.2, 0.4;
+    host_.T_c_w0 = SE3d(SO3d::exp(Vec3(0.05, -0.1, 0.02)), Vec3(0.1, 0.0, 0.3));
+    host_.xi << -0.5, 0.2, 0.3, -0.4, 0.9, -0.2;
+  }
+
+  // Host pixel -> (bearing, row).
+  void hostPoint(const Vec2& px, Vec3& b, double& v_h) const {
+    ASSERT_TRUE(cam_->unproject(px, b));
+    v_h = px.y();
+  }
+
+  RsProjectionOptions exact(bool jac = true) const {
+    RsProjectionOptions o;
+    o.tolerance_px = 1e-11;
+    o.max_iterations = 50;
+    o.jacobians = jac;
+    return o;
+  }
+
+  std::unique_ptr<CameraModel> cam_;
+  RowTiming timing_;
+  RsFrame target_, host_;
+};
+
+TEST_F(RsHostProjectionTest, EqualsTheWorldPointForm) {
+  Vec3 b;
+  double v_h;
+  hostPoint(Vec2(70.0, 200.0), b, v_h);
+  const double rho = 0.4;
+  const RsHostProjection r = projectRollingShutter(*cam_, timing_, host_, target_, b, v_h, rho);
+  // The host saw the point at its row's time: X = T_h_w(t_h)^-1 (b / rho).
+  const SE3d T_h_w = SE3d::exp(host_.xi * timing_.rowTime(v_h)) * host_.T_c_w0;
+  const Vec3 X = T_h_w.inverse() * Vec3(b / rho);
+  const RsProjection w = projectRollingShutter(*cam_, timing_, target_, X);
+  ASSERT_TRUE(r.valid);
+  EXPECT_LT((r.uv - w.uv).norm(), 1e-9);
+  EXPECT_JACOBIAN_NEAR(r.d_uv_d_T0, w.d_uv_d_T0, 1e-9);
+  EXPECT_JACOBIAN_NEAR(r.d_uv_d_xi, w.d_uv_d_xi, 1e-9);
+}
+
+TEST_F(RsHostProjectionTest, JacobiansMatchNumeric) {
+  for (bool top_down : {true, false}) {
+    const RowTiming tm = RowTiming::rolling(timing_.y0, 4e-5, top_down);
+    for (const Vec2& px : {Vec2(70.0, 200.0), Vec2(250.0, 30.0), Vec2(159.5, 127.5), Vec2(0.0, 255.0)}) {
+      for (double rho : {0.05, 0.5, 3.0}) {
+        Vec3 b;
+        double v_h;
+        hostPoint(px, b, v_h);
+        const RsHostProjection r = projectRollingShutter(*cam_, tm, host_, target_, b, v_h, rho, exact());
+        if (!r.valid) continue;  // a corner of the wide-angle host may leave the target's view
+        SCOPED_TRACE(::testing::Message() << "px " << px.transpose() << " rho " << rho << " top_down " << top_down);
+        const auto uvAt = [&](const RowTiming& t, const RsFrame& h, const RsFrame& f, double r_) {
+          return projectRollingShutter(*cam_, t, h, f, b, v_h, r_, exact(false)).uv;
+        };
+        const auto byHostPose = [&](const SE3d& T) { return uvAt(tm, RsFrame{T, host_.xi}, target_, rho); };
+        const auto byHostTwist = [&](const Vec6& xi) { return uvAt(tm, RsFrame{host_.T_c_w0, xi}, target_, rho); };
+        const auto byTargetPose = [&](const SE3d& T) { return uvAt(tm, host_, RsFrame{T, target_.xi}, rho); };
+        const auto byTargetTwist = [&](const Vec6& xi) { return uvAt(tm, host_, RsFrame{target_.T_c_w0, xi}, rho); };
+        const auto byIdepth = [&](double r_) { return uvAt(tm, host_, target_, r_); };
+        const auto byDelay = [&](double ld) {
+          RowTiming t = tm;
+          t.line_delay_s = ld;
+          return uvAt(t, host_, target_, rho);
+        };
+        EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_Th0, numericJacobian(byHostPose, host_.T_c_w0, leftPlus<SE3d>, 6, 1e-5),
+                                 1e-6, 1e-5);
+        EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_xi_h, numericJacobian(byHostTwist, host_.xi, vectorPlus, 6, 1e-5), 1e-6,
+                                 1e-5);
+        EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_T0, numericJacobian(byTargetPose, target_.T_c_w0, leftPlus<SE3d>, 6, 1e-5),
+                                 1e-6, 1e-5);
+        EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_xi, numericJacobian(byTargetTwist, target_.xi, vectorPlus, 6, 1e-5), 1e-6,
+                                 1e-5);
+        EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_idepth, numericJacobian(byIdepth, rho, vectorPlus, 1, 1e-6 * rho), 1e-6,
+                                 1e-5);
+        EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_line_delay, numericJacobian(byDelay, tm.line_delay_s, vectorPlus, 1, 1e-8),
+                                 1e-6, 1e-2);
+      }
+    }
+  }
+}
+
+TEST_F(RsHostProjectionTest, NonPositiveInverseDepthIsInvalid) {
+  Vec3 b;
+  double v_h;
+  hostPoint(Vec2(100.0, 100.0), b, v_h);
+  EXPECT_FALSE(projectRollingShutter(*cam_, timing_, host_, target_, b, v_h, 0.0).valid);
+  EXPECT_FALSE(projectRollingShutter(*cam_, timing_, host_, target_, b, v_h, -0.3).valid);
+  EXPECT_FALSE(projectRollingShutter(*cam_, timing_, host_, target_, b, v_h, std::nan("")).valid);
+}
+
+TEST_F(RsHostProjectionTest, BatchEqualsSinglePoints) {
+  const int n = 40;
+  Eigen::Matrix3Xd B(3, n);
+  Eigen::VectorXd v_h(n), rho(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec2 px(8.0 * i, 6.0 * i + 3.0);
+    Vec3 b;
+    ASSERT_TRUE(cam_->unproject(px, b));
+    B.col(i) = b;
+    v_h[i] = px.y();
+    rho[i] = (i % 7 == 3) ? -1.0 : 0.1 + 0.05 * i;  // some invalid ones in between
+  }
+  std::vector<RsHostProjection> out;
+  projectRollingShutter(*cam_, timing_, host_, target_, B, v_h, rho, out);
+  ASSERT_EQ(out.size(), static_cast<size_t>(n));
+  int n_valid = 0;
+  for (int i = 0; i < n; ++i) {
+    const RsHostProjection s = projectRollingShutter(*cam_, timing_, host_, target_, Vec3(B.col(i)), v_h[i], rho[i]);
+    ASSERT_EQ(out[i].valid, s.valid) << i;
+    if (!s.valid) continue;
+    ++n_valid;
+    EXPECT_EQ(out[i].uv, s.uv);
+    EXPECT_EQ(out[i].d_uv_d_Th0, s.d_uv_d_Th0);
+    EXPECT_EQ(out[i].d_uv_d_line_delay, s.d_uv_d_line_delay);
+  }
+  EXPECT_GT(n_valid, n / 2);
+}
+
+TEST_F(RsHostProjectionTest, RowTimingFromShutterPlugins) {
+  CameraCalibration calib = cam_->calibration();
+  calib.line_delay_s = 0.0;
+  for (const char* readout : {"top_down", "bottom_up"}) {
+    auto rs = makePlugin<ShutterModel>("shutter.rolling", {{"line_delay_us", 25.0}, {"readout", readout}});
+    rs->setCalibration(calib);
+    const RowTiming t = RowTiming::from(*rs, *cam_);
+    EXPECT_EQ(t.y0, calib.rowZero());
+    EXPECT_DOUBLE_EQ(t.line_delay_s, 25e-6);
+    EXPECT_EQ(t.direction, std::string(readout) == "top_down" ? 1.0 : -1.0);
+    for (double v : {0.0, 100.0, 255.0}) EXPECT_NEAR(t.rowTime(v), rs->rowTime(v), 1e-18);
+  }
+  auto gs = makePlugin<ShutterModel>("shutter.global");
+  gs->setCalibration(calib);
+  const RowTiming t = RowTiming::from(*gs, *cam_);
+  EXPECT_EQ(t.dtDv(), 0.0);
+  EXPECT_EQ(t.dRowTimeDLineDelay(10.0), 0.0);
+}
+
+}  // namespace
+}  // namespace rsvio::test
