@@ -50,7 +50,15 @@ std::vector<fs::path> kalibrCandidates(const fs::path& dir) {
           (e.path().extension() == ".yaml" || e.path().extension() == ".yml") && e.path() != dir / "dso" / "camchain.yaml")
         found.push_back(e.path());
     }
-    std::sort(found.begin(), found.end());
+    // Kalibr writes camchain-<bag>.yaml (cameras only) and camchain-imucam-<bag>.yaml (with T_cam_imu and
+    // timeshift_cam_imu); TUM names theirs "..._camimu_...". The camera-IMU one is the one to use.
+    auto camImu = [](const fs::path& p) {
+      const std::string n = p.filename().string();
+      return n.find("imucam") != std::string::npos || n.find("camimu") != std::string::npos;
+    };
+    std::sort(found.begin(), found.end(), [&](const fs::path& a, const fs::path& b) {
+      return camImu(a) != camImu(b) ? camImu(a) : a < b;
+    });
     out.insert(out.end(), found.begin(), found.end());
   }
   return out;

@@ -217,6 +217,21 @@ TEST(EurocSource, ChainsKalibrCameraWithoutOwnImuExtrinsic) {
   expectIsometryNear(src->sensors().camera.T_B_C, (T_c1_c0 * T_c0_i).inverse(), 1e-12);
 }
 
+TEST(EurocSource, PrefersKalibrsCameraImuChainOverItsCameraOnlyChain) {
+  TempDir tmp;
+  DatasetSpec spec;
+  spec.sensor_yaml = false;
+  writeDataset(tmp.path(), spec);
+  const Eigen::Isometry3d T_c_i = someTransform(0.2, {0, 0, 1}, {0.01, 0.02, 0.03});
+  writeText(tmp.path() / "camchain-dataset-calib.yaml", kalibrCamera("cam0", 64, 48, ""));
+  writeText(tmp.path() / "camchain-imucam-dataset-calib.yaml",
+            kalibrCamera("cam0", 64, 48, "  T_cam_imu:\n" + kalibrMatrix(T_c_i, "  ")) + "  timeshift_cam_imu: -0.002\n");
+  auto src = makeSource();
+  src->open(tmp.str());
+  expectIsometryNear(src->sensors().camera.T_B_C, T_c_i.inverse(), 1e-12);
+  EXPECT_DOUBLE_EQ(src->sensors().camera.time_offset_s, -0.002);
+}
+
 TEST(EurocSource, ImageScaleResizesAndRescalesIntrinsicsAndLineDelay) {
   TempDir tmp;
   DatasetSpec spec;
@@ -230,7 +245,7 @@ TEST(EurocSource, ImageScaleResizesAndRescalesIntrinsicsAndLineDelay) {
   EXPECT_DOUBLE_EQ(c.intrinsics[0], 0.5 * 45.8654);
   EXPECT_DOUBLE_EQ(c.intrinsics[2], 0.5 * (31.7215 + 0.5) - 0.5);
   EXPECT_DOUBLE_EQ(c.line_delay_s, 40e-6);  // the same readout time over half the rows
-  // The middle row keeps its time: y0' * ld' == y0 * ld up to the half-pixel of the new grid.
+  // Frame times are those of the middle row, which resizing keeps.
   EXPECT_EQ(src->frameTime(0), frameStamp(spec, 0));
   const Frame f = src->readFrame(0);
   EXPECT_EQ(f.image.cols, 32);
