@@ -1,10 +1,87 @@
-// rsvio compare: placeholder until its issue lands; says so and exits non-zero.
+// rsvio compare: run every (config, dataset, run) as a child `rsvio run` in a bounded pool of worker
+// processes and tabulate ATE, failures and fps (framework: rsvio/eval/compare.h; docs/eval.md).
+// Exit code: 0 when every run is ok, 1 when at least one failed (the table and files are still
+// written), 2 for a usage or setup error (missing config or dataset, unwritable --out).
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
 #include "commands.h"
+#include "rsvio/core/error.h"
+#include "rsvio/eval/compare.h"
 
 namespace rsvio::app {
-void addCompareCommand(CLI::App& root, const GlobalOptions& /*g*/, CommandResult& r) {
-  auto* sub = root.add_subcommand("compare", "(not available yet)");
-  sub->allow_extras();
-  sub->callback([&r] { r.exit_code = notAvailableYet("compare", "its issue has not landed"); });
+namespace {
+
+struct CompareArgs {
+  std::vector<std::string> configs, datasets;
+  int runs = 1;
+  int jobs = 2;
+  double timeout_s = 3600;
+  std::string out;
+  std::string runner;  // hidden: a program used instead of this binary (tests, scripts)
+};
+
+std::string thisBinary() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) throw Error("rsvio compare: cannot find its own binary through /proc/self/exe (" + ec.message() + ")");
+  return p.string();
 }
+
+int runCompareCommand(const CompareArgs& a, const GlobalOptions& g) {
+  namespace fs = std::filesystem;
+  if (a.runs < 1) throw ConfigError("--runs = " + std::to_string(a.runs) + ". Violated constraint: >= 1");
+  if (a.jobs < 1) throw ConfigError("--jobs = " + std::to_string(a.jobs) + ". Violated constraint: >= 1");
+  for (const auto& c : a.configs) {
+    if (!fs::is_regular_file(c)) throw ConfigError("--configs: " + c + ": no such file");
+  }
+  for (const auto& d : a.datasets) {
+    if (!fs::is_directory(d)) throw ConfigError("--data: " + d + ": no such folder");
+  }
+  const auto jobs = eval::planCompareJobs(a.configs, a.datasets, a.runs, a.out);
+  eval::RunArgvBuilder builder;
+  if (!a.runner.empty()) {
+    builder = [runner = a.runner](const eval::CompareJob& j) { return eval::rsvioRunArgv(runner, {}, j); };
+  } else {
+    std::vector<std::string> pre;  // pass the plugin search path on, one "--plugin-path=P" per folder
+    for (const auto& p : g.plugin_path) pre.push_back("--plugin-path=" + p);
+    builder = [bin = thisBinary(), pre](const eval::CompareJob& j) { return eval::rsvioRunArgv(bin, pre, j); };
+  }
+  eval::CompareOptions opt;
+  opt.jobs = a.jobs;
+  opt.timeout_s = a.timeout_s;
+  if (g.verbosity > 0) {
+    std::cout << "rsvio compare: " << jobs.size() << " runs (" << a.configs.size() << " configs x " << a.datasets.size()
+              << " datasets x " << a.runs << " seeds), " << a.jobs << " at a time, into " << a.out << "/runs\n";
+  }
+  const auto result = eval::runCompare(jobs, builder, opt, g.verbosity > 0 ? &std::cout : nullptr);
+  const nlohmann::json invocation = {{"configs", a.configs}, {"data", a.datasets}, {"runs", a.runs},
+                                     {"jobs", a.jobs},       {"timeout_s", a.timeout_s}};
+  eval::writeCompareOutputs(a.out, result, invocation);
+  std::cout << "\n" << eval::formatCompareTable(result);
+  std::cout << "written: " << (fs::path(a.out) / "compare.csv").string() << ", "
+            << (fs::path(a.out) / "compare.json").string() << "\n";
+  return result.failed() == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+void addCompareCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
+  auto args = std::make_shared<CompareArgs>();
+  auto* sub = root.add_subcommand("compare", "run configs x datasets x seeds in parallel and tabulate ATE, failures, fps");
+  sub->add_option("--configs", args->configs, "config files (JSON)")->required();
+  sub->add_option("--data", args->datasets, "dataset folders (EuRoC layout)")->required();
+  sub->add_option("--runs", args->runs, "runs per (config, dataset); run k uses --seed k")->capture_default_str();
+  sub->add_option("--jobs", args->jobs, "worker processes at once")->capture_default_str();
+  sub->add_option("--timeout-s", args->timeout_s, "a run longer than this is killed and counted as failed (0: none)")
+      ->capture_default_str();
+  sub->add_option("--out", args->out, "output folder: runs/<config>/<dataset>/<k>/, compare.csv, compare.json")
+      ->required();
+  // Hidden (empty group): replaces `<this binary>` as the child program; it gets the same arguments
+  // ("run --config C --data D --out O --seed k"). For tests and scripts with a stand-in runner.
+  sub->add_option("--runner", args->runner, "program to run instead of this binary")->group("");
+  sub->callback([args, &g, &r] { r.exit_code = runCompareCommand(*args, g); });
+}
+
 }  // namespace rsvio::app
