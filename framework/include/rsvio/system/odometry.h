@@ -1,0 +1,76 @@
+// The estimator as `rsvio run` drives it: one object per run, built from a validated run config
+// (config/validate.h: runConfigSchema) and the data source's sensors; fed IMU samples and frames in
+// time order; asked for results at the end. It never reads ground truth.
+//
+// Contract
+// - Frames arrive in order; before addFrame(f), every IMU sample with t_imu <= f.t_ns + time offset
+//   (+ the frame's readout) has been given to addImu (the run loop guarantees it).
+// - World: VO: the first keyframe's camera frame, free scale ("# frame: camera" outputs);
+//   VIO: the metric world W_m, z up, after initialisation ("# frame: body" outputs).
+// - status(): "ok" while running; after a divergence (exploding energy, scale collapse, too few
+//   inliers, tracking lost without recovery) "failed" with a one-line reason. Once failed, further
+//   frames are ignored; what was estimated before the failure stays available.
+// - Determinism: the same config, seed, data and thread count give bit-identical results.
+// - Thread use: at most config "threads" threads.
+#pragma once
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "rsvio/core/types.h"
+#include "rsvio/io/diagnostics_log.h"
+#include "rsvio/io/states.h"
+#include "rsvio/io/trajectory.h"
+
+namespace rsvio {
+
+class PluginHost;
+
+struct MapPoint {
+  Eigen::Vector3f p_w;      // world frame (W_f for VO, W_m for VIO)
+  float intensity = 0.f;    // host intensity
+};
+
+struct FrameStatus {
+  bool tracked = false;
+  bool keyframe = false;
+  std::string message;      // e.g. "initialising", "tracking lost: too few inliers"
+};
+
+class Odometry {
+ public:
+  // effective_config: validated against runConfigSchema(); seed overrides config "seed".
+  Odometry(const nlohmann::json& effective_config, PluginHost& host, const SensorSetup& sensors);
+  ~Odometry();
+  Odometry(const Odometry&) = delete;
+  Odometry& operator=(const Odometry&) = delete;
+
+  void addImu(const ImuSample& sample);
+  FrameStatus addFrame(const Frame& frame);
+  // Final optimisation; marginalises everything so the diagnostics log holds final linearisations.
+  void finish();
+
+  bool failed() const;
+  std::string failureReason() const;
+
+  // Results (valid any time; complete after finish()).
+  io::Trajectory frameTrajectory() const;     // every tracked frame, refined (conventions.md, Outputs)
+  io::Trajectory keyframeTrajectory() const;  // keyframes after their last optimisation
+  std::vector<MapPoint> points() const;
+  std::vector<StateRow> states() const;
+  DiagnosticsLog diagnostics() const;
+  std::map<std::string, double> stageMs() const;  // mean ms per call of each stage
+  long numKeyframes() const;
+  bool usesImu() const;
+  double scale() const;                            // metres per W_f unit (1 without IMU)
+  std::vector<std::string> warnings() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rsvio
