@@ -104,6 +104,7 @@ struct ResidualKernel {
 struct PatternResidual {
   float r[kPatternSize];       // residuals, intensity units
   float w[kPatternSize];       // IRLS weights w_g^2 * huberWeight
+  float wg2[kPatternSize];     // squared gradient weights w_g^2
   float gx[kPatternSize];      // d r / d u' per level-0 pixel
   float gy[kPatternSize];      // d r / d v' per level-0 pixel
   float energy = 0.f;          // sum w_g^2 * rho(r)
@@ -136,6 +137,7 @@ inline bool evaluatePattern(const Sampler& target, float u, float v, const float
     const float wg2 = wg * wg;
     out.r[i] = r;
     out.w[i] = wg2 * huberWeight(r, k.huber);
+    out.wg2[i] = wg2;
     out.gx[i] = s[1] * inv_scale;
     out.gy[i] = s[2] * inv_scale;
     energy += wg2 * huberEnergy(r, k.huber);

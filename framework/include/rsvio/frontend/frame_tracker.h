@@ -1,0 +1,172 @@
+// Direct frame tracking: coarse-to-fine alignment of a new frame against the newest keyframe's points
+// (DSO's CoarseTracker, Engel et al. 2018, sec. 4.1; paper sec. IV-A, "frontend").
+//
+// Contract
+// - State of the new frame: central pose T_c_w^0 (world -> camera at the image timestamp, row y0) and
+//   affine brightness (a, b). Its rolling-shutter twist is NOT estimated here: it is an input (the
+//   prior's or the previous frame's), and every point is projected with the rolling-shutter constraint
+//   solved (geometry/rs_projection.h), so the Jacobian w.r.t. T_c_w^0 includes the row dependence.
+//   Poses are perturbed on the LEFT, T <- exp(delta) T (rsvio/lie/lie.h).
+// - Reference: the keyframe's pose, twist, affine brightness, pyramid and points (host pixel, inverse
+//   depth along the camera's unit bearing, i.e. 1 / distance). Every point is fixed in the world at
+//   its host row time. On pyramid level l the points are merged per level pixel (inverse depths
+//   averaged, as DSO's makeCoarseDepthL0) and the pattern is used in level pixels.
+// - Residual and weights: photometric_residual.h (8-pixel pattern, Huber, gradient weights), with W = I
+//   (no pattern warp) and DSO's cutoff: a pattern pixel with |r| > cutoff counts with the energy of
+//   |r| = cutoff and no derivative; when more than 60 % saturate the cutoff is doubled (up to 50 x).
+// - Optimisation per level: Levenberg-Marquardt on (delta(6), a, b) from the coarsest level down
+//   (DSO's trackNewestCoarse: lambda 0.01, x0.5 on success, x4 on failure, 10/20/50/50/50
+//   iterations on levels 0..4), stop when the scaled increment is below 1e-3.
+// - Guesses (the motion prior's predict(), best first): each is tracked through all levels; one is
+//   abandoned at a level where its RMSE exceeds abort_factor x the best RMSE reached so far on that
+//   level; the first whose level-0 RMSE is below retrack_factor x the last frame's stops the search
+//   (DSO's setting_reTrackThreshold). The best (lowest level-0 RMSE) wins.
+// - Tracking lost: the result says Lost with a reason when no guess leaves enough points in view,
+//   when the winner's inlier ratio (share of pattern pixels with |r| <= cutoff) is below
+//   min_inlier_ratio, its RMSE above max_rmse, or its brightness change out of range. A lost result
+//   still carries the best pose found; callers must not use it as a measurement.
+// - Determinism: points are processed in fixed blocks whose sums are added in block order, so the
+//   result is identical for 1 and 2 threads (at most 2 are used).
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rsvio/core/types.h"
+#include "rsvio/geometry/rs_projection.h"
+#include "rsvio/lie/se3.h"
+#include "rsvio/photometric/image_pyramid.h"
+#include "rsvio/photometric/photometric_residual.h"
+#include "rsvio/plugin/plugin.h"
+
+namespace rsvio {
+
+class CameraModel;
+class BlockRunner;
+
+struct TrackerOptions {
+  ResidualOptions residual;
+  int max_levels = 5;                               // pyramid levels used (coarsest = max_levels - 1)
+  std::array<int, 6> max_iterations = {10, 20, 50, 50, 50, 50};  // per level (DSO)
+  double cutoff_th = 20.0;                          // intensity; DSO setting_coarseCutoffTH
+  double lambda_initial = 0.01;
+  double converge_eps = 1e-3;                       // norm of the scaled increment
+  double retrack_factor = 1.5;                      // accept a guess below this x the last RMSE
+  double abort_factor = 1.5;                        // drop a guess above this x the best level RMSE
+  // Tracking-lost tests on the winner.
+  int min_points = 30;                              // points with a residual on level 0
+  double min_inlier_ratio = 0.5;
+  double max_rmse = 14.0;                           // intensity (sqrt of energy per pattern pixel)
+  double max_abs_log_alpha = 1.5;                   // |log(exposure ratio exp(a_j - a_i))| (DSO)
+  double max_abs_b = 200.0;                         // intensity
+  // Which brightness parameters the tracker estimates (the back end sets these from the photometric
+  // models: photometric.affine present -> both true).
+  bool estimate_a = true;
+  bool estimate_b = true;
+  int threads = 1;                                  // 1 or 2; results are identical
+
+  static ParamTable paramTable();                   // keys track_* (see frontend_options.h)
+  // Reads the track_* keys; `residual` is left for the caller (ResidualOptions::fromParams).
+  static TrackerOptions fromParams(const Params& p);
+};
+
+// One point of the reference keyframe.
+struct TrackingPoint {
+  Vec2 uv = Vec2::Zero();   // host pixel, level 0 (integer for selected points)
+  double idepth = 0.0;      // inverse distance along the unit bearing of uv
+  double weight = 1.0;      // relative weight when points merge on coarse levels (e.g. depth information)
+};
+
+struct TrackingReference {
+  int64_t frame_id = -1;
+  int64_t t_ns = 0;
+  SE3d T_c_w;                           // central pose
+  Vec6 twist = Vec6::Zero();            // per second
+  AffineBrightness affine;
+  double exposure_ms = std::numeric_limits<double>::quiet_NaN();
+  std::shared_ptr<const ImagePyramid> pyramid;
+  std::vector<TrackingPoint> points;
+};
+
+// What the tracker needs to know about the new frame besides its image.
+struct TrackingFrame {
+  int64_t t_ns = 0;
+  Vec6 twist = Vec6::Zero();            // kept fixed (prior or previous frame)
+  double exposure_ms = std::numeric_limits<double>::quiet_NaN();
+  AffineBrightness affine_guess;        // usually the previous frame's
+};
+
+struct TrackResult {
+  enum class Status { Ok, Lost };
+  Status status = Status::Lost;
+  std::string reason;                   // empty when Ok; one line otherwise
+  SE3d T_c_w;                           // central pose of the new frame
+  AffineBrightness affine;
+  double rmse = 0.0;                    // level 0, intensity units
+  std::array<double, 6> level_rmse{};   // per level (NaN where not reached)
+  double inlier_ratio = 0.0;            // level 0, |r| <= cutoff
+  int num_points = 0;                   // points with a residual on level 0
+  int guess_index = -1;                 // which guess won
+  int guesses_tried = 0;
+  int iterations = 0;                   // LM iterations over all levels and guesses
+  // DSO's keyframe indicators: RMS pixel shift of the level-0 points with the full relative motion,
+  // and with its translation only (rotation removed).
+  double flow_rt_px = 0.0;
+  double flow_t_px = 0.0;
+  bool ok() const { return status == Status::Ok; }
+};
+
+class FrameTracker {
+ public:
+  FrameTracker(const TrackerOptions& options, const CameraModel& camera, const RowTiming& timing);
+  ~FrameTracker();
+  FrameTracker(const FrameTracker&) = delete;
+  FrameTracker& operator=(const FrameTracker&) = delete;
+
+  // Builds the per-level point sets. Points outside the host image or with idepth <= 0 are skipped.
+  void setReference(const TrackingReference& reference);
+  bool hasReference() const { return static_cast<bool>(ref_.pyramid); }
+  const TrackingReference& reference() const { return ref_; }
+  int numReferencePoints(int level) const;
+
+  // Tracks one frame from the guesses (best first; an empty list means "the keyframe's pose").
+  TrackResult track(const ImagePyramid& frame, const TrackingFrame& info, const std::vector<SE3d>& guesses);
+
+  // RMSE per level of the last successful track (DSO's lastCoarseRMSE); NaN before the first.
+  const std::array<double, 6>& lastRmse() const { return last_rmse_; }
+
+  const TrackerOptions& options() const { return options_; }
+
+  // Energy of the pose/affine pair on one level, for tests: rmse, inlier ratio, points in view.
+  struct LevelEnergy {
+    double energy = 0.0;
+    int num_terms = 0;       // pattern pixels evaluated
+    int num_saturated = 0;   // |r| > cutoff
+    int num_points = 0;      // points in view
+    double rmse() const { return num_terms > 0 ? std::sqrt(energy / num_terms) : std::nan(""); }
+  };
+  LevelEnergy levelEnergy(const ImagePyramid& frame, const TrackingFrame& info, int level, const SE3d& T_c_w,
+                          const AffineBrightness& affine) const;
+
+ private:
+  struct LevelPoints;
+  struct Block;
+  struct Linearization;
+  struct Attempt;
+
+  void evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
+                double alpha_ratio, double cutoff, bool linearize, Linearization& out) const;
+  Attempt trackGuess(const ImagePyramid& frame, const TrackingFrame& info, const SE3d& guess,
+                     const std::array<double, 6>& abort_rmse) const;
+
+  TrackerOptions options_;
+  const CameraModel& camera_;
+  RowTiming timing_;
+  TrackingReference ref_;
+  std::vector<std::unique_ptr<LevelPoints>> levels_;
+  std::array<double, 6> last_rmse_;
+  std::unique_ptr<BlockRunner> runner_;
+};
+
+}  // namespace rsvio

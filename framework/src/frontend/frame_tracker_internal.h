@@ -1,0 +1,92 @@
+// Private types of FrameTracker shared by frame_tracker.cpp and frame_tracker_solve.cpp.
+#pragma once
+#include <Eigen/Core>
+#include <cmath>
+#include <vector>
+
+#include "rsvio/frontend/block_runner.h"
+#include "rsvio/frontend/frame_tracker.h"
+#include "rsvio/interfaces/camera.h"
+#include "rsvio/lie/se3.h"
+
+namespace rsvio {
+
+// Points per block of the deterministic parallel sums (fixed: results do not depend on threads).
+constexpr int kBlockPoints = 128;
+
+using Mat88 = Eigen::Matrix<double, 8, 8>;
+using Vec8 = Eigen::Matrix<double, 8, 1>;
+
+// Normal equations of (delta(6), a, b) on one level, with energy statistics.
+struct FrameTracker::Linearization {
+  Mat88 H = Mat88::Zero();
+  Vec8 b = Vec8::Zero();
+  double energy = 0.0;
+  int num_terms = 0;
+  int num_saturated = 0;
+  int num_points = 0;
+
+  void setZero() {
+    H.setZero();
+    b.setZero();
+    energy = 0.0;
+    num_terms = num_saturated = num_points = 0;
+  }
+  void add(const Linearization& o) {
+    H += o.H;
+    b += o.b;
+    energy += o.energy;
+    num_terms += o.num_terms;
+    num_saturated += o.num_saturated;
+    num_points += o.num_points;
+  }
+  double meanEnergy() const { return num_terms > 0 ? energy / num_terms : std::nan(""); }
+  double saturatedRatio() const { return num_terms > 0 ? static_cast<double>(num_saturated) / num_terms : 1.0; }
+};
+
+// A block of reference points with its own scratch buffers and partial sums.
+struct FrameTracker::Block {
+  int begin = 0;                  // index of the first point of the level
+  Eigen::Matrix3Xd X_w;           // world points
+  // scratch, reused across evaluations (no allocation in steady state)
+  Eigen::Matrix3Xd P;
+  Eigen::Matrix2Xd uv;
+  std::vector<uint8_t> valid;
+  std::vector<Jac23> J;
+  std::vector<RsProjection> proj;
+  FrameTracker::Linearization lin;
+};
+
+struct FrameTracker::LevelPoints {
+  int n = 0;
+  std::vector<PatternHost> host;
+  std::vector<Vec2> host_uv0;   // level-0 coordinates of the (merged) host pixel
+  std::vector<Vec3> host_point; // point in the host camera at its row time
+  std::vector<Block> blocks;
+};
+
+// One guess tracked through the levels.
+struct FrameTracker::Attempt {
+  bool ok = false;
+  std::string failure;
+  SE3d T_c_w;
+  AffineBrightness affine;
+  std::array<double, 6> level_rmse;
+  int iterations = 0;
+  Attempt() { level_rmse.fill(std::nan("")); }
+};
+
+// [I, -[p]x]: d(exp(d) p) / d d at d = 0 (left perturbation, tangent (translation; rotation)).
+inline Eigen::Matrix<double, 3, 6> dLeftAction(const Vec3& p) {
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>().setIdentity();
+  J.rightCols<3>() = -SO3d::hat(p);
+  return J;
+}
+
+// t_target / t_host when both exposures are known, else 1.
+inline double exposureRatio(double host_ms, double target_ms) {
+  return (host_ms > 0.0 && target_ms > 0.0) ? target_ms / host_ms : 1.0;
+}
+
+}  // namespace rsvio

@@ -1,0 +1,237 @@
+// Frame tracker: Levenberg-Marquardt per level, guesses, tracking-lost tests, keyframe indicators
+// (contract in rsvio/frontend/frame_tracker.h).
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "frame_tracker_internal.h"
+#include "rsvio/core/error.h"
+
+namespace rsvio {
+
+namespace {
+
+// DSO's increment scaling (SCALE_XI_TRANS = 0.5, SCALE_XI_ROT = 1, SCALE_A = 10, SCALE_B = 1000):
+// the convergence test is on the increment in these units.
+double scaledNorm(const Vec8& inc) {
+  Vec8 s = inc;
+  s.head<3>() /= 0.5;
+  s(6) /= 10.0;
+  s(7) /= 1000.0;
+  return s.norm();
+}
+
+std::string fmt(double v, int prec = 2) {
+  std::ostringstream o;
+  o.setf(std::ios::fixed);
+  o.precision(prec);
+  o << v;
+  return o.str();
+}
+
+}  // namespace
+
+FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const TrackingFrame& info,
+                                               const SE3d& guess, const std::array<double, 6>& abort_rmse) const {
+  Attempt a;
+  a.T_c_w = guess;
+  a.affine = info.affine_guess;
+  const double exposure_ratio = exposureRatio(ref_.exposure_ms, info.exposure_ms);
+  const int coarsest = std::min(static_cast<int>(levels_.size()), frame.numLevels()) - 1;
+  bool repeated = false;
+  Linearization lin, lin_new;
+  for (int lvl = coarsest; lvl >= 0; --lvl) {
+    const ImageLevel& img = frame.level(lvl);
+    double cutoff_mult = 1.0;
+    evaluate(img, lvl, RsFrame{a.T_c_w, info.twist}, a.affine, exposure_ratio, options_.cutoff_th, true, lin);
+    while (lin.saturatedRatio() > 0.6 && cutoff_mult < 50.0) {
+      cutoff_mult *= 2.0;
+      evaluate(img, lvl, RsFrame{a.T_c_w, info.twist}, a.affine, exposure_ratio, options_.cutoff_th * cutoff_mult,
+               true, lin);
+    }
+    if (lin.num_points == 0) {
+      a.failure = "no reference point in view on level " + std::to_string(lvl);
+      return a;
+    }
+    double lambda = options_.lambda_initial;
+    const int max_it = options_.max_iterations[static_cast<size_t>(std::min(lvl, 5))];
+    for (int it = 0; it < max_it; ++it) {
+      Mat88 Hl = lin.H;
+      for (int i = 0; i < 8; ++i) Hl(i, i) *= (1.0 + lambda);
+      // Fixed brightness parameters: drop their rows and columns.
+      int dim = 6;
+      int idx[8] = {0, 1, 2, 3, 4, 5, -1, -1};
+      if (options_.estimate_a) idx[dim++] = 6;
+      if (options_.estimate_b) idx[dim++] = 7;
+      Eigen::MatrixXd Hr(dim, dim);
+      Eigen::VectorXd br(dim);
+      for (int i = 0; i < dim; ++i) {
+        br(i) = lin.b(idx[i]);
+        for (int j = 0; j < dim; ++j) Hr(i, j) = Hl(idx[i], idx[j]);
+      }
+      const Eigen::VectorXd xr = Hr.ldlt().solve(-br);
+      Vec8 inc = Vec8::Zero();
+      for (int i = 0; i < dim; ++i) inc(idx[i]) = xr(i);
+      // DSO's extrapolation when lambda is small: a slightly longer step.
+      if (lambda < 1e-3) inc *= std::sqrt(std::sqrt(1e-3 / lambda));
+      if (!inc.allFinite()) inc.setZero();
+
+      const SE3d T_new = SE3d::exp(inc.head<6>()) * a.T_c_w;
+      AffineBrightness aff_new = a.affine;
+      aff_new.a += inc(6);
+      aff_new.b += inc(7);
+      evaluate(img, lvl, RsFrame{T_new, info.twist}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
+               lin_new);
+      ++a.iterations;
+      const bool accept = lin_new.num_terms > 0 && lin_new.meanEnergy() < lin.meanEnergy();
+      if (accept) {
+        std::swap(lin, lin_new);
+        a.T_c_w = T_new;
+        a.affine = aff_new;
+        lambda *= 0.5;
+      } else {
+        lambda *= 4.0;
+        if (lambda < 1e-3) lambda = 1e-3;
+      }
+      if (!(scaledNorm(inc) > options_.converge_eps)) break;
+    }
+    a.level_rmse[static_cast<size_t>(lvl)] = std::sqrt(lin.meanEnergy());
+    if (a.level_rmse[static_cast<size_t>(lvl)] > options_.abort_factor * abort_rmse[static_cast<size_t>(lvl)]) {
+      a.failure = "worse than an earlier guess on level " + std::to_string(lvl);
+      return a;
+    }
+    // DSO repeats a level once when it had to raise the cutoff (the start was poor).
+    if (cutoff_mult > 1.0 && !repeated) {
+      ++lvl;
+      repeated = true;
+    }
+  }
+  a.ok = std::isfinite(a.level_rmse[0]) && a.T_c_w.translation().allFinite();
+  if (!a.ok) a.failure = "diverged";
+  return a;
+}
+
+TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& info,
+                                const std::vector<SE3d>& guesses_in) {
+  if (!hasReference()) throw Error("FrameTracker::track: no reference keyframe (call setReference first)");
+  if (frame.width() != ref_.pyramid->width() || frame.height() != ref_.pyramid->height())
+    throw Error("FrameTracker::track: frame size differs from the reference keyframe's");
+  const std::vector<SE3d> guesses = guesses_in.empty() ? std::vector<SE3d>{ref_.T_c_w} : guesses_in;
+
+  TrackResult res;
+  std::array<double, 6> achieved;
+  achieved.fill(std::nan(""));
+  Attempt best;
+  bool have_best = false;
+  std::string last_failure;
+  for (size_t g = 0; g < guesses.size(); ++g) {
+    const Attempt a = trackGuess(frame, info, guesses[g], achieved);
+    ++res.guesses_tried;
+    res.iterations += a.iterations;
+    if (a.ok && (!have_best || a.level_rmse[0] < best.level_rmse[0])) {
+      best = a;
+      have_best = true;
+      res.guess_index = static_cast<int>(g);
+    }
+    if (!a.ok) last_failure = a.failure;
+    if (have_best)
+      for (size_t l = 0; l < achieved.size(); ++l)
+        if (std::isfinite(a.level_rmse[l]) && !(achieved[l] <= a.level_rmse[l])) achieved[l] = a.level_rmse[l];
+    if (have_best && best.level_rmse[0] < options_.retrack_factor * last_rmse_[0]) break;
+  }
+
+  if (!have_best) {
+    res.status = TrackResult::Status::Lost;
+    res.reason = "no guess converged (" + std::to_string(res.guesses_tried) + " tried; last: " + last_failure + ")";
+    res.T_c_w = guesses.front();
+    res.affine = info.affine_guess;
+    res.level_rmse.fill(std::nan(""));
+    return res;
+  }
+  res.T_c_w = best.T_c_w;
+  res.affine = best.affine;
+  res.level_rmse = best.level_rmse;
+
+  // Lost tests on the winner, at level 0 with the base cutoff.
+  const LevelEnergy e = levelEnergy(frame, info, 0, best.T_c_w, best.affine);
+  res.rmse = e.rmse();
+  res.num_points = e.num_points;
+  res.inlier_ratio = e.num_terms > 0 ? 1.0 - static_cast<double>(e.num_saturated) / e.num_terms : 0.0;
+  const double log_alpha = std::log(exposureRatio(ref_.exposure_ms, info.exposure_ms)) + best.affine.a - ref_.affine.a;
+  res.status = TrackResult::Status::Lost;
+  if (e.num_points < options_.min_points) {
+    res.reason = "only " + std::to_string(e.num_points) + " reference points in view (min " +
+                 std::to_string(options_.min_points) + ")";
+  } else if (res.inlier_ratio < options_.min_inlier_ratio) {
+    res.reason = "inlier ratio " + fmt(res.inlier_ratio) + " below " + fmt(options_.min_inlier_ratio) +
+                 " (rmse " + fmt(res.rmse) + ")";
+  } else if (!(res.rmse <= options_.max_rmse)) {
+    res.reason = "rmse " + fmt(res.rmse) + " above " + fmt(options_.max_rmse);
+  } else if ((options_.estimate_a && std::abs(log_alpha) > options_.max_abs_log_alpha) ||
+             (options_.estimate_b && std::abs(best.affine.b) > options_.max_abs_b)) {
+    res.reason = "brightness change out of range (log gain " + fmt(log_alpha) + ", b " + fmt(best.affine.b) + ")";
+  } else {
+    res.status = TrackResult::Status::Ok;
+    last_rmse_ = best.level_rmse;
+  }
+
+  // DSO's flow indicators on the level-0 points, central poses.
+  const LevelPoints& L0 = *levels_[0];
+  if (L0.n > 0) {
+    const SE3d T_t_h = best.T_c_w * ref_.T_c_w.inverse();
+    Eigen::Matrix3Xd P(3, 2 * L0.n);
+    for (int i = 0; i < L0.n; ++i) {
+      const Vec3& Xh = L0.host_point[static_cast<size_t>(i)];
+      P.col(2 * i) = T_t_h * Xh;
+      P.col(2 * i + 1) = Xh + T_t_h.translation();
+    }
+    Eigen::Matrix2Xd uv;
+    std::vector<uint8_t> valid;
+    camera_.project(P, uv, valid, nullptr);
+    double srt = 0, st = 0;
+    int n = 0;
+    for (int i = 0; i < L0.n; ++i) {
+      if (!valid[static_cast<size_t>(2 * i)] || !valid[static_cast<size_t>(2 * i + 1)]) continue;
+      srt += (uv.col(2 * i) - L0.host_uv0[static_cast<size_t>(i)]).squaredNorm();
+      st += (uv.col(2 * i + 1) - L0.host_uv0[static_cast<size_t>(i)]).squaredNorm();
+      ++n;
+    }
+    if (n > 0) {
+      res.flow_rt_px = std::sqrt(srt / n);
+      res.flow_t_px = std::sqrt(st / n);
+    }
+  }
+  return res;
+}
+
+ParamTable TrackerOptions::paramTable() {
+  const TrackerOptions d;
+  return {
+      paramInt("track_levels", d.max_levels, 1, 6, "", "pyramid levels used by the tracker (coarsest = levels - 1)"),
+      paramDouble("track_cutoff", d.cutoff_th, 1.0, 255.0, "intensity",
+                  "residuals above this count as saturated in tracking (DSO: 20)"),
+      paramDouble("track_retrack_factor", d.retrack_factor, 1.0, 100.0, "",
+                  "stop trying guesses once the RMSE is below this x the last frame's (DSO: 1.5)"),
+      paramDouble("track_abort_factor", d.abort_factor, 1.0, 100.0, "",
+                  "drop a guess on a level where its RMSE exceeds this x the best so far (DSO: 1.5)"),
+      paramInt("track_min_points", d.min_points, 1, 100000, "", "fewer reference points in view: tracking lost"),
+      paramDouble("track_min_inlier_ratio", d.min_inlier_ratio, 0.0, 1.0, "",
+                  "lower share of pattern pixels below the cutoff: tracking lost"),
+      paramDouble("track_max_rmse", d.max_rmse, 0.1, 1000.0, "intensity", "higher level-0 RMSE: tracking lost"),
+  };
+}
+
+TrackerOptions TrackerOptions::fromParams(const Params& p) {
+  TrackerOptions o;
+  o.max_levels = static_cast<int>(p.getInt("track_levels"));
+  o.cutoff_th = p.getDouble("track_cutoff");
+  o.retrack_factor = p.getDouble("track_retrack_factor");
+  o.abort_factor = p.getDouble("track_abort_factor");
+  o.min_points = static_cast<int>(p.getInt("track_min_points"));
+  o.min_inlier_ratio = p.getDouble("track_min_inlier_ratio");
+  o.max_rmse = p.getDouble("track_max_rmse");
+  return o;
+}
+
+}  // namespace rsvio

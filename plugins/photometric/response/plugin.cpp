@@ -1,0 +1,35 @@
+// photometric.response: registration and parameter table (the model: response_model.h).
+#include <memory>
+
+#include "response_model.h"
+#include "rsvio/plugin/plugin_api.h"
+
+namespace rsvio {
+namespace {
+
+ParamTable table() {
+  return {
+      paramEnum("mode", "auto", {"auto", "calibrated", "estimate"},
+                "auto: the dataset's inverse response (pcalib.txt) when given, else estimate a gamma online"),
+      paramDouble("initial_gamma", 1.0, 0.1, 10.0, "", "initial g of the estimated response G(B) = 255 (B/255)^g"),
+  };
+}
+
+void registerAll(PluginRegistrar& r) {
+  r.add<PhotometricModel>(
+      {"photometric.response", PluginKind::Photometric, "1.0.0",
+       "Camera response: applies the calibrated inverse response, or estimates a gamma online", table(), ""},
+      [](const Params& p) {
+        const std::string m = p.getString("mode");
+        const ResponseModel::Mode mode = m == "calibrated" ? ResponseModel::Mode::Calibrated
+                                         : m == "estimate" ? ResponseModel::Mode::Estimate
+                                                           : ResponseModel::Mode::Auto;
+        const std::string where = p.where().empty() ? "photometric.response" : p.where();
+        return std::make_unique<ResponseModel>(mode, p.getDouble("initial_gamma"), where);
+      });
+}
+
+}  // namespace
+}  // namespace rsvio
+
+RSVIO_PLUGIN_ENTRY(rsvio::registerAll)

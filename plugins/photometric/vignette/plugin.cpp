@@ -1,0 +1,38 @@
+// photometric.vignette: registration and parameter table (the model: vignette_model.h).
+#include <memory>
+
+#include "rsvio/plugin/plugin_api.h"
+#include "vignette_model.h"
+
+namespace rsvio {
+namespace {
+
+ParamTable table() {
+  return {
+      paramEnum("mode", "auto", {"auto", "calibrated", "estimate"},
+                "auto: the dataset's vignette.png when given, else estimate a radial polynomial online"),
+      paramDouble("min_value", 0.05, 1e-3, 1.0, "", "calibrated vignette values are clamped to this before dividing"),
+      paramArray("initial", {0.0, 0.0, 0.0}, 3, "", "initial v1 v2 v3 of V(r) = 1 + v1 r^2 + v2 r^4 + v3 r^6"),
+  };
+}
+
+void registerAll(PluginRegistrar& r) {
+  r.add<PhotometricModel>(
+      {"photometric.vignette", PluginKind::Photometric, "1.0.0",
+       "Vignetting: divides by the calibrated vignette, or estimates a radial polynomial online", table(), ""},
+      [](const Params& p) {
+        const std::string m = p.getString("mode");
+        const VignetteModel::Mode mode = m == "calibrated" ? VignetteModel::Mode::Calibrated
+                                         : m == "estimate" ? VignetteModel::Mode::Estimate
+                                                           : VignetteModel::Mode::Auto;
+        const std::vector<double> v = p.getArray("initial");
+        const std::string where = p.where().empty() ? "photometric.vignette" : p.where();
+        return std::make_unique<VignetteModel>(mode, p.getDouble("min_value"), Eigen::Vector3d(v[0], v[1], v[2]),
+                                               where);
+      });
+}
+
+}  // namespace
+}  // namespace rsvio
+
+RSVIO_PLUGIN_ENTRY(rsvio::registerAll)
