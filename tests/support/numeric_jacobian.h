@@ -7,7 +7,8 @@
 //   J.col(i) = ( minus(f(plus(x0, +eps e_i)), f(x0)) - minus(f(plus(x0, -eps e_i)), f(x0)) ) / (2 eps),
 // so J is the derivative of the output in the chart `minus` around f(x0) w.r.t. the chart `plus`
 // around x0. Without `minus` the output is converted to an Eigen::VectorXd (scalars become 1-vectors,
-// matrices are flattened column-major) and differenced as a vector.
+// matrices are flattened column-major) and differenced as a vector. f must return a value (write
+// `return Eigen::Vector3d(T * p);`), not an Eigen expression that refers to f's locals.
 //
 // Ready-made charts (use the one matching the analytic Jacobian's convention):
 //   vectorPlus        x + d                          (Eigen vectors, or a scalar with dim = 1)

@@ -121,11 +121,12 @@ class SE3 {
     return so3_ * p + translation_;
   }
 
-  // Rotations within tol (angle) and translations within tol * max(1, |t|).
+  // Rotations within tol (angle) and translations within tol * max(1, |t|, |t'|).
   bool isApprox(const SE3& other, Scalar tol = Scalar(1e3) * SO3Type::Constants::epsilon()) const {
     using std::max;
     return so3_.isApprox(other.so3_, tol) &&
-           (translation_ - other.translation_).norm() <= tol * max(Scalar(1), translation_.norm());
+           (translation_ - other.translation_).norm() <=
+               tol * max(Scalar(1), max(translation_.norm(), other.translation_.norm()));
   }
 
   // ---- Jacobians (Barfoot, "State Estimation for Robotics", sec. 7.1.5, with xi = (rho; phi)).

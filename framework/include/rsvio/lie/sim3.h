@@ -125,11 +125,12 @@ class Sim3 {
     return rxso3_ * p + translation_;
   }
 
-  // RxSO3 parts within tol and translations within tol * max(1, |t|).
+  // RxSO3 parts within tol and translations within tol * max(1, |t|, |t'|).
   bool isApprox(const Sim3& other, Scalar tol = Scalar(1e3) * SO3Type::Constants::epsilon()) const {
     using std::max;
     return rxso3_.isApprox(other.rxso3_, tol) &&
-           (translation_ - other.translation_).norm() <= tol * max(Scalar(1), translation_.norm());
+           (translation_ - other.translation_).norm() <=
+               tol * max(Scalar(1), max(translation_.norm(), other.translation_.norm()));
   }
 
   // d(exp(d) T p)/dd at d = 0 = [I, -[T p]x, T p]  (3x7). d(T p)/dp = s R.
