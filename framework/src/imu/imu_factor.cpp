@@ -66,6 +66,16 @@ Vec15 ImuFactor::residual(const ImuState& si, const ImuState& sj, double time_of
   return r;
 }
 
+ImuState predictState(const ImuState& s, const ImuPreintegration& pre, const Vec3& g) {
+  const double dt = pre.dt();
+  const ImuPreintegration::Delta d = pre.corrected(s.bias);
+  ImuState r = s;
+  r.R_w_i = s.R_w_i * d.R;                                                  // eq. 13
+  r.p_w_i = s.p_w_i + s.v_w * dt + 0.5 * g * dt * dt + s.R_w_i * d.p;       // eq. 14
+  r.v_w = s.v_w + g * dt + s.R_w_i * d.v;                                   // eq. 15
+  return r;
+}
+
 Mat15 ImuFactor::information() const {
   const Mat15 cov = pre_.fullCovariance();
   // Symmetric positive definite for any interval with at least one step and non-zero noise.

@@ -49,4 +49,8 @@ class ImuFactor {
   Vec3 g_ = gravityWorld();
 };
 
+// The state at the end of a preintegrated interval from the state at its start (eqs. 13-15 with the
+// bias correction of eq. 44 at s.bias): the prediction the residuals compare against.
+ImuState predictState(const ImuState& s, const ImuPreintegration& pre, const Vec3& gravity_w = gravityWorld());
+
 }  // namespace rsvio
