@@ -34,9 +34,68 @@ std::vector<HostPoint> makeHostPoints(const CameraModel& camera, const ImageLeve
 
 namespace detail {
 
+namespace {
+
+Eigen::Matrix<double, 3, 6> dLeft(const Vec3& p) {
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>().setIdentity();
+  J.rightCols<3>() = -SO3d::hat(p);
+  return J;
+}
+
+// Global shutter: every row at t = 0, so the RS solve reduces to one projection and the twists and
+// the line delay have no effect; the same Jacobians as rs_projection.h without a per-point exp.
+void projectGlobal(const CameraModel& camera, const ObservationFrames& frames, const std::vector<HostPoint>& points,
+                   std::vector<Observation>& out) {
+  const SE3d T_th = frames.target.T_c_w0 * frames.host.T_c_w0.inverse();
+  const Eigen::Matrix3d R_th = T_th.rotationMatrix();
+  const Eigen::Matrix3d R_t = frames.target.T_c_w0.rotationMatrix();
+  const Eigen::Index n = static_cast<Eigen::Index>(points.size());
+  Eigen::Matrix3Xd X_t(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const HostPoint& p = points[static_cast<size_t>(i)];
+    X_t.col(i) = p.idepth > 0.0 ? Vec3(T_th * Vec3(p.bearing / p.idepth)) : Vec3::Constant(std::nan(""));
+  }
+  Eigen::Matrix2Xd uv;
+  std::vector<uint8_t> valid;
+  std::vector<Jac23> Jc;
+  camera.project(X_t, uv, valid, &Jc);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const HostPoint& p = points[static_cast<size_t>(i)];
+    RsHostProjection& r = out[static_cast<size_t>(i)].proj;
+    r = RsHostProjection();
+    r.uv = uv.col(i);
+    r.iterations = 1;
+    r.converged = true;
+    r.valid = valid[static_cast<size_t>(i)] && p.idepth > 0.0;
+    if (!r.valid) continue;
+    const Jac23& J = Jc[static_cast<size_t>(i)];
+    const Vec3 X_h = p.bearing / p.idepth;
+    r.d_uv_d_T0 = J * dLeft(X_t.col(i));
+    r.d_uv_d_X = J * R_t;
+    const Eigen::Matrix<double, 2, 3> JR = J * R_th;
+    r.d_uv_d_Th0 = -JR * dLeft(X_h);
+    r.d_uv_d_idepth = JR * (-p.bearing / (p.idepth * p.idepth));
+  }
+}
+
+}  // namespace
+
 void projectObservations(const CameraModel& camera, const RowTiming& timing, const ObservationFrames& frames,
                          const std::vector<HostPoint>& points, std::vector<Observation>& out) {
   const Eigen::Index n = static_cast<Eigen::Index>(points.size());
+  out.resize(points.size());
+  if (timing.dtDv() == 0.0 && timing.direction == 0.0) {
+    projectGlobal(camera, frames, points, out);
+    const double alpha = frames.exposure_ratio * std::exp(frames.target_affine.a - frames.host_affine.a);
+    const Eigen::Matrix3d R_w_h = frames.host.T_c_w0.rotationMatrix().transpose();
+    for (size_t i = 0; i < points.size(); ++i) {
+      Observation& o = out[i];
+      o.alpha = alpha;
+      if (o.proj.valid) o.warp = o.proj.d_uv_d_X * R_w_h * points[i].d_bearing_d_uv / points[i].idepth;
+    }
+    return;
+  }
   Eigen::Matrix3Xd bearing(3, n);
   Eigen::VectorXd v_h(n), rho(n);
   for (Eigen::Index i = 0; i < n; ++i) {

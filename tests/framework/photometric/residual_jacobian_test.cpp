@@ -153,23 +153,39 @@ TEST(PointObservation, AllJacobiansMatchNumericDifferences) {
 }
 
 TEST(PointObservation, GlobalShutterJacobiansToo) {
+  // A global shutter takes a faster path (no RS solve); same contract, same checks.
   const ObsSetup s;
   const RowTiming gs = RowTiming::global(127.5);
   const std::vector<Observation> base = s.evaluate(s.frames, s.points, nullptr, gs);
+  const std::vector<Observation> rs_zero = s.evaluate(s.frames, s.points, nullptr, RowTiming::rolling(127.5, 0.0, true));
   std::vector<Eigen::Matrix2d> warps;
   for (const Observation& o : base) warps.push_back(o.warp);
   for (size_t i = 0; i < s.points.size(); ++i) {
+    SCOPED_TRACE("point " + std::to_string(i));
     ASSERT_TRUE(base[i].valid);
+    // Same geometry as the general RS path with a zero line delay.
+    EXPECT_LT((base[i].proj.uv - rs_zero[i].proj.uv).norm(), 1e-9);
+    EXPECT_TRUE(base[i].proj.d_uv_d_Th0.isApprox(rs_zero[i].proj.d_uv_d_Th0, 1e-9));
+    EXPECT_TRUE(base[i].warp.isApprox(rs_zero[i].warp, 1e-9));
     const ObservationJacobians J = observationJacobians(base[i], s.points[i], s.frames);
-    const Eigen::MatrixXd n = numericJacobian(
-        [&](const SE3d& T) {
-          ObservationFrames f = s.frames;
-          f.target.T_c_w0 = T;
-          return residualOf(s.evaluate(f, s.points, &warps, gs)[i]);
-        },
+    auto r = [&](const ObservationFrames& fr, const std::vector<HostPoint>& pts) {
+      return residualOf(s.evaluate(fr, pts, &warps, gs)[i]);
+    };
+    const Eigen::MatrixXd n_Tt = numericJacobian(
+        [&](const SE3d& T) { ObservationFrames f = s.frames; f.target.T_c_w0 = T; return r(f, s.points); },
         s.frames.target.T_c_w0, test::leftPlus<SE3d>, 6, 2e-4);
-    EXPECT_TRUE(near(J.d_r_d_T_target, n));
+    EXPECT_TRUE(near(J.d_r_d_T_target, n_Tt)) << "target pose";
+    const Eigen::MatrixXd n_Th = numericJacobian(
+        [&](const SE3d& T) { ObservationFrames f = s.frames; f.host.T_c_w0 = T; return r(f, s.points); },
+        s.frames.host.T_c_w0, test::leftPlus<SE3d>, 6, 2e-4);
+    EXPECT_TRUE(near(J.d_r_d_T_host, n_Th)) << "host pose";
+    const Eigen::MatrixXd n_id = numericJacobian(
+        [&](double rho) { std::vector<HostPoint> p = s.points; p[i].idepth = rho; return r(s.frames, p); },
+        s.points[i].idepth, test::vectorPlus, 1, 1e-3);
+    EXPECT_TRUE(near(J.d_r_d_idepth, n_id)) << "inverse depth";
     EXPECT_TRUE(J.d_r_d_xi_target.isZero());  // a global shutter has no row time
+    EXPECT_TRUE(J.d_r_d_xi_host.isZero());
+    EXPECT_TRUE(J.d_r_d_line_delay.isZero());
   }
 }
 
