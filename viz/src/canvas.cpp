@@ -63,7 +63,10 @@ Canvas::Canvas(int width, int height, Rgb background)
 
 Canvas::~Canvas() = default;
 
-double Canvas::baseFont() const { return std::clamp(std::min(width() / 1.4, static_cast<double>(height())) / 38.0, 9.0, 22.0); }
+double Canvas::baseFont() const {
+  if (base_font_ > 0) return base_font_;
+  return std::clamp(std::min(width() / 1.4, static_cast<double>(height())) / 38.0, 9.0, 22.0);
+}
 
 cv::Size Canvas::textSize(const std::string& s, double px, int* descent) const {
   int base = 0;
@@ -316,7 +319,7 @@ void colourBar(Canvas& c, const cv::Rect& bar, const std::function<Rgb(double)>&
     c.line({double(bar.x + bar.width), y}, {bar.x + bar.width + 4.0, y}, kAxis);
     c.text(formatNumber(v), bar.x + bar.width + 6.0, y, f, kText, HAlign::kLeft, VAlign::kMiddle);
   }
-  if (!label.empty()) c.text(label, bar.x + bar.width / 2.0, bar.y - f * 0.6, f, kText, HAlign::kCenter, VAlign::kBottom);
+  if (!label.empty()) c.text(label, bar.x + bar.width / 2.0, bar.y - f * 0.9, f, kText, HAlign::kCenter, VAlign::kBottom);
 }
 
 void messageFigure(Canvas& c, const std::string& title, const std::vector<std::string>& lines, Rgb colour) {

@@ -38,6 +38,7 @@ class Canvas {
   int height() const { return img_.rows; }
   // A font size that reads well at this figure size (px of cap height + ascenders).
   double baseFont() const;
+  void setBaseFont(double px) { base_font_ = px; }  // fixed size instead of one from the figure size
 
   // Text of height px, anchored at (x, y) as aligned. Returns the text's box.
   cv::Rect text(const std::string& s, double x, double y, double px, Rgb colour, HAlign h = HAlign::kLeft,
@@ -61,6 +62,7 @@ class Canvas {
   struct Font;
   cv::Mat img_;
   std::unique_ptr<Font> font_;
+  double base_font_ = 0;
 };
 
 struct Axis {

@@ -21,6 +21,11 @@ Rgb turbo(double t) {
   return {toByte(r), toByte(g), toByte(b)};
 }
 
+Rgb errorMap(double t) {
+  if (std::isnan(t)) return kNoData;
+  return turbo(0.1 + 0.85 * std::clamp(t, 0.0, 1.0));
+}
+
 Rgb viridis(double t) {
   if (std::isnan(t)) return kNoData;
   static constexpr std::array<std::array<uint8_t, 3>, 11> kStops = {{{0x44, 0x01, 0x54}, {0x48, 0x24, 0x75},

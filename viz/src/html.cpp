@@ -68,6 +68,7 @@ th{background:#f4f4f4}td.n{text-align:right;font-variant-numeric:tabular-nums}
 .err{color:#c0392b;font-weight:600}.muted{color:#777}
 .figs{display:grid;grid-template-columns:repeat(auto-fill,minmax(540px,1fr));gap:18px}
 figure{margin:0;border:1px solid #e3e3e3;padding:8px;background:#fff}figure img{width:100%;height:auto;display:block}
+figure.wide{grid-column:1/-1}
 figcaption{font-size:0.88em;color:#555;margin-top:6px}
 .bar{background:#4a90d9;height:10px;display:inline-block}
 pre{background:#f7f7f7;padding:10px;overflow:auto;font-size:0.85em}
@@ -92,7 +93,7 @@ void figuresSection(std::ostringstream& b, const std::vector<FigureLink>& figure
   b << "<div class=\"figs\">\n";
   for (const auto& f : figures) {
     const std::string href = rel(f.path, page);
-    b << "<figure><a href=\"" << href << "\"><img src=\"" << href << "\" alt=\"" << esc(fs::path(f.path).filename().string())
+    b << "<figure" << (f.wide ? " class=\"wide\"" : "") << "><a href=\"" << href << "\"><img src=\"" << href << "\" alt=\"" << esc(fs::path(f.path).filename().string())
       << "\"></a><figcaption>" << esc(f.caption) << "</figcaption></figure>\n";
   }
   b << "</div>\n";

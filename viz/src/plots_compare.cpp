@@ -56,8 +56,32 @@ CompareGrid makeCompareGrid(const std::vector<CompareRun>& runs) {
   return g;
 }
 
+namespace {
+
+// Figure size and font for a grid drawn at its natural size.
+FigureSize autoGridSize(const CompareGrid& g, double& font) {
+  const int ncol = std::max<int>(1, static_cast<int>(g.sequences.size()) * g.runs);
+  const int nrow = std::max<int>(1, static_cast<int>(g.configs.size()));
+  const double gap = g.runs > 1 ? 0.5 : 0.15;
+  const double cols = ncol + gap * (std::max<int>(1, static_cast<int>(g.sequences.size())) - 1);
+  const double sq = std::clamp(1100.0 / cols, 16.0, 48.0);
+  font = std::clamp(sq * 0.5, 12.0, 16.0);
+  Canvas probe(10, 10);
+  int label_w = 0;
+  for (const auto& cfg : g.configs) label_w = std::max(label_w, probe.textSize(cfg, font * 0.85).width);
+  label_w = std::min(label_w, 420);
+  const double w = font + label_w + font * 0.6 + sq * cols + font * 6.0 + 4;
+  const double h = font * 4.2 + std::max(sq * nrow, font * 8.0) + font * 3.0 + 4;  // room for the colour bar
+  return {static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h))};
+}
+
+}  // namespace
+
 void renderCompareGrid(const CompareGrid& g, const std::string& path, FigureSize size) {
+  double font = 0;
+  if (size.width <= 0 || size.height <= 0) size = autoGridSize(g, font);
   Canvas c(size.width, size.height);
+  if (font > 0) c.setBaseFont(font);
   if (g.configs.empty() || g.sequences.empty()) {
     messageFigure(c, g.title, {"no runs to compare"}, kMuted);
     saveOrThrow(c, path);
@@ -102,7 +126,7 @@ void renderCompareGrid(const CompareGrid& g, const std::string& path, FigureSize
       c.line({double(rc.x + 2), double(rc.y + 2)}, {double(rc.x + rc.width - 3), double(rc.y + rc.height - 3)}, kRed, t);
       c.line({double(rc.x + rc.width - 3), double(rc.y + 2)}, {double(rc.x + 2), double(rc.y + rc.height - 3)}, kRed, t);
     } else if (std::isfinite(cell.ate_m)) {
-      c.fillRect(rc, turbo(normalise(cell.ate_m, lo, hi, true)));
+      c.fillRect(rc, errorMap(normalise(cell.ate_m, lo, hi, true)));
     } else {
       c.fillRect(rc, kNoData);
     }
@@ -129,9 +153,11 @@ void renderCompareGrid(const CompareGrid& g, const std::string& path, FigureSize
   cv::Rect nr(static_cast<int>(t1.x + t1.width + f * 1.2), fr.y, ls, ls);
   c.fillRect(nr, kNoData);
   c.text("no ground truth", nr.x + ls + f * 0.4, nr.y + ls / 2.0, f * 0.8, kText, HAlign::kLeft, VAlign::kMiddle);
+  // A short grid (few configurations) still gets a readable colour bar.
+  const double bar_h = std::max(grid_h, std::min(size.height - y0 - f, f * 8.0));
   colourBar(c, cv::Rect(static_cast<int>(x0 + grid_w + f * 1.2), static_cast<int>(y0), static_cast<int>(std::max(6.0, f * 0.9)),
-                        static_cast<int>(grid_h)),
-            turbo, lo, hi, true, "ATE [m]");
+                        static_cast<int>(bar_h)),
+            errorMap, lo, hi, true, "ATE [m]");
   saveOrThrow(c, path);
 }
 

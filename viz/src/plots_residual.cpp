@@ -68,14 +68,14 @@ void drawHeat(Canvas& c, PlotArea& pa, const Bins& b, double x_lo, double x_hi, 
   const cv::Rect& a = pa.area();
   colourBar(c, cv::Rect(a.x + a.width + static_cast<int>(f * 1.2), a.y + static_cast<int>(f), static_cast<int>(f),
                         a.height - static_cast<int>(f)),
-            viridis, 0, vmax, false, bar_label);
+            viridis, 0, vmax, false, "mean " + bar_label);
 }
 
 }  // namespace
 
 void renderResidualRowTime(const ResidualMapInput& in, const std::string& path, FigureSize size) {
   Canvas c(size.width, size.height);
-  const std::string label = in.weighted ? "mean |w r|" : "mean |r|";
+  const std::string label = in.weighted ? "|w r|" : "|r|";
   if (in.obs.empty() || in.image_height <= 0) {
     messageFigure(c, "Residual against image row and time", {"no residuals in the diagnostics log"}, kMuted);
     saveOrThrow(c, path);
@@ -88,11 +88,16 @@ void renderResidualRowTime(const ResidualMapInput& in, const std::string& path, 
   }
   const double span_s = std::max(1e-3, (t1 - t0) * 1e-9);
   const double y0 = 0.5 * (in.image_height - 1);
-  const int nt = std::max(1, in.time_bins), nr = std::max(1, std::min(in.row_bins, in.image_height));
+  // No more time bins than frames: a bin between two frames would be an empty stripe.
+  std::vector<int64_t> stamps;
+  for (const auto& o : in.obs) stamps.push_back(o.t_ns);
+  std::sort(stamps.begin(), stamps.end());
+  const int frames = static_cast<int>(std::unique(stamps.begin(), stamps.end()) - stamps.begin());
+  const int nt = std::max(1, std::min(in.time_bins, frames)), nr = std::max(1, std::min(in.row_bins, in.image_height));
   Bins b(nt, nr);
   for (const auto& o : in.obs) {
     const double row = y0 + o.row_minus_y0;
-    const int it = std::min(nt - 1, static_cast<int>((o.t_ns - t0) * 1e-9 / span_s * nt));
+    const int it = t1 > t0 ? std::min(nt - 1, static_cast<int>(static_cast<double>(o.t_ns - t0) / (t1 - t0) * nt)) : 0;
     const int ir = static_cast<int>(std::floor((row + 0.5) / in.image_height * nr));
     b.add(it, ir, value(o, in.weighted));
   }
@@ -109,7 +114,7 @@ void renderResidualRowTime(const ResidualMapInput& in, const std::string& path, 
 
 void renderResidualImage(const ResidualMapInput& in, const std::string& path, FigureSize size) {
   Canvas c(size.width, size.height);
-  const std::string label = in.weighted ? "mean |w r|" : "mean |r|";
+  const std::string label = in.weighted ? "|w r|" : "|r|";
   if (in.obs.empty() || in.image_width <= 0 || in.image_height <= 0) {
     messageFigure(c, "Residual over the image", {"no residuals in the diagnostics log"}, kMuted);
     saveOrThrow(c, path);

@@ -143,12 +143,12 @@ void renderPlanTrajectory(const PlanTrajectory& p, const std::string& path, Figu
   if (coloured) {
     for (size_t i = 1; i < p.est_x.size(); ++i) {
       const double e = 0.5 * (p.est_err_m[i - 1] + p.est_err_m[i]);
-      c.line(pa.toPx(p.est_x[i - 1], p.est_y[i - 1]), pa.toPx(p.est_x[i], p.est_y[i]), turbo(e / emax), 2);
+      c.line(pa.toPx(p.est_x[i - 1], p.est_y[i - 1]), pa.toPx(p.est_x[i], p.est_y[i]), errorMap(e / emax), 2);
     }
-    legend.emplace_back("estimate (colour = error)", turbo(0.15));
+    legend.emplace_back("estimate (colour = error)", errorMap(0.15));
     colourBar(c, cv::Rect(area.x + area.width + static_cast<int>(f * 1.2), area.y + static_cast<int>(f), static_cast<int>(f),
                           area.height - static_cast<int>(f)),
-              turbo, 0, emax, false, "error [m]");
+              errorMap, 0, emax, false, "error [m]");
   } else {
     pa.series(p.est_x, p.est_y, kBlue, 2);
     legend.emplace_back("estimate", kBlue);

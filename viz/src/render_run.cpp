@@ -107,8 +107,10 @@ RenderStatus renderRun(const io::Snapshot& s, const RenderOptions& o) {
         if (!guard.ok()) throw Error(guard.message());
         const auto files = renderScenes(s, o.scene, out.string());
         for (size_t i = 0; i < files.size(); ++i) {
-          add(files[i], std::string("3D, ") + viewName(o.scene.views[i]) +
-                            " view: estimate against ground truth, coloured by error; points; keyframes");
+          add(files[i], files.size() < o.scene.views.size()
+                            ? std::string("3D view: nothing to draw")
+                            : std::string("3D, ") + viewName(o.scene.views[i]) +
+                                  " view: estimate against ground truth, coloured by error; points; keyframes");
         }
       });
     }
@@ -219,12 +221,10 @@ RenderStatus renderCompare(const std::vector<CompareRun>& runs, const CompareRen
     std::vector<FigureLink> links;
     attempt("compare_grid.png", st, [&] {
       const auto p = figs / "compare_grid.png";
-      const int square = std::max(1, static_cast<int>(g.sequences.size()) * g.runs);
-      // Wide enough for the squares to stay square-ish with long grids.
-      FigureSize size{std::max(o.figure.width, 220 + 28 * square), std::max(o.figure.height / 2, 140 + 40 * static_cast<int>(g.configs.size()))};
-      renderCompareGrid(g, p.string(), size);
+      renderCompareGrid(g, p.string(), FigureSize{0, 0});  // sized to the grid
       st.figures.push_back(p.string());
-      links.push_back({p.string(), "ATE of every run (rows: configurations; columns: sequences x runs); white with a cross: failed"});
+      links.push_back({p.string(), "ATE of every run (rows: configurations; columns: sequences x runs); white with a cross: failed",
+                       true});
     });
     attempt("ate_per_config.png", st, [&] {
       const auto p = figs / "ate_per_config.png";

@@ -8,6 +8,7 @@
 #include <vtkCellArray.h>
 #include <vtkCommand.h>
 #include <vtkCoordinate.h>
+#include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
@@ -215,6 +216,26 @@ vtkSmartPointer<vtkActor2D> make2DLine(const std::vector<Eigen::Vector2d>& pts, 
 
 std::string fmt(double v) { return detail::formatNumber(v); }
 
+// Breaks text into lines of at most `width` characters at spaces (long words stay whole).
+std::string wrap(const std::string& s, size_t width) {
+  std::string out, line, word;
+  auto flush_word = [&] {
+    if (word.empty()) return;
+    if (!line.empty() && line.size() + 1 + word.size() > width) {
+      out += line + "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+    word.clear();
+  };
+  for (char c : s) {
+    if (c == ' ') flush_word();
+    else word += c;
+  }
+  flush_word();
+  return out + line;
+}
+
 void writePng(vtkRenderWindow* win, const std::string& path, int width, int height) {
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(win);
@@ -278,7 +299,7 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
     if (!g.est.empty()) {
       std::vector<Rgb> col(g.est.size(), kPlainEstimate);
       if (coloured) {
-        for (size_t i = 0; i < g.est.size(); ++i) col[i] = turbo(g.est_err[i] / g.err_max);
+        for (size_t i = 0; i < g.est.size(); ++i) col[i] = errorMap(g.est_err[i] / g.err_max);
       }
       scene->AddActor(makeLines(g.est, col, true, 2.5 * px));
     }
@@ -287,15 +308,19 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
       lut->SetNumberOfTableValues(256);
       lut->SetRange(0, g.err_max);
       for (int i = 0; i < 256; ++i) {
-        const Rgb c = turbo(i / 255.0);
+        const Rgb c = errorMap(i / 255.0);
         lut->SetTableValue(i, c.r / 255.0, c.g / 255.0, c.b / 255.0, 1.0);
       }
       lut->Build();
       vtkNew<vtkScalarBarActor> bar;
       bar->SetLookupTable(lut);
       bar->SetTitle("error [m]");
-      bar->SetNumberOfLabels(5);
-      bar->SetLabelFormat("%-#6.3g");
+      // Round tick values (0, 0.05, 0.1, ...) rather than VTK's evenly split range.
+      vtkNew<vtkDoubleArray> ticks;
+      for (double v : detail::niceTicks(0, g.err_max, 5)) ticks->InsertNextValue(v);
+      bar->SetUseCustomLabels(true);
+      bar->SetCustomLabels(ticks);
+      bar->SetLabelFormat("%.3g");
       bar->UnconstrainedFontSizeOn();
       bar->GetTitleTextProperty()->SetFontSize(font);
       bar->GetLabelTextProperty()->SetFontSize(static_cast<int>(font * 0.85));
@@ -317,7 +342,7 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
       Rgb colour;
     };
     std::vector<Entry> legend;
-    if (!g.est.empty()) legend.push_back({coloured ? "estimate (colour = error)" : "estimate", coloured ? turbo(0.15) : kPlainEstimate});
+    if (!g.est.empty()) legend.push_back({coloured ? "estimate (colour = error)" : "estimate", coloured ? errorMap(0.1) : kPlainEstimate});
     if (!g.gt.empty()) legend.push_back({"ground truth", kGtColour});
     if (!g.points.empty()) legend.push_back({"points (grey = intensity)", Rgb{120, 120, 120}});
     if (!g.frusta.empty()) legend.push_back({"keyframes", kFrustumColour});
@@ -329,7 +354,8 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
                                  y - font * 0.45, false));
     }
   } else {
-    scene->AddActor2D(makeText(g.message, font, Rgb{200, 30, 30}, sw / 2, H / 2.0, false, false, true));
+    scene->AddActor2D(makeText(wrap(g.message, static_cast<size_t>(std::max(20.0, sw / (font * 0.55)))), font, Rgb{200, 30, 30},
+                               sw / 2, H / 2.0, false, false, true));
   }
 
   const Eigen::AlignedBox3d bounds = g.bounds.isEmpty() ? Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1))
@@ -345,7 +371,9 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
 
   fs::create_directories(out_dir);
   std::vector<std::string> files;
-  for (View v : o.views) {
+  // Nothing to draw: one picture of the reason is enough (the first asked view's file).
+  const std::vector<View> views = g.empty() && !o.views.empty() ? std::vector<View>{o.views.front()} : o.views;
+  for (View v : views) {
     std::vector<vtkSmartPointer<vtkProp>> overlays;  // removed again after this view
     auto overlay = [&](vtkSmartPointer<vtkProp> p) {
       scene->AddViewProp(p);

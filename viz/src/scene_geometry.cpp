@@ -80,7 +80,7 @@ SceneGeometry buildSceneGeometry(const io::Snapshot& s, bool points, bool frusta
   }
 
   const double extent = g.bounds.isEmpty() ? 1.0 : std::max(1e-3, g.bounds.sizes().maxCoeff());
-  g.frustum_size = 0.04 * extent;
+  g.frustum_size = 0.03 * extent;
   if (frusta && !s.keyframes.empty()) {
     const size_t n = s.keyframes.size();
     const size_t step = max_frusta > 0 && n > static_cast<size_t>(max_frusta) ? (n + max_frusta - 1) / max_frusta : 1;

@@ -46,7 +46,7 @@ struct RunSummary {
   double fps = kNaN;
   double realtime_factor = kNaN;
   double scale = kNaN;
-  std::vector<std::pair<std::string, double>> stage_ms;  // in the file's order
+  std::vector<std::pair<std::string, double>> stage_ms;  // by stage name (JSON objects are read sorted)
   std::string dataset;        // report.json "dataset" as written
   double ate_rmse_m = kNaN;   // report.json eval.ate_rmse_m
   std::string align;          // report.json eval.align

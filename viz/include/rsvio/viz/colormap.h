@@ -1,6 +1,6 @@
 // Colour maps shared by every figure, so that "error" looks the same in 3D views, the error plot and
 // the compare grid.
-// - turbo (Google's polynomial fit of the Turbo map): errors; dark blue = small, dark red = large.
+// - turbo (Google's polynomial fit of the Turbo map) via errorMap: errors; blue = small, dark red = large.
 // - viridis (matplotlib's, 11 stops, linear in between): residual heat maps (perceptually uniform).
 // - grey: point intensities, mapped into [lo, hi] grey levels so points never vanish on white.
 // Inputs are clamped to [0, 1]; NaN gives the "no data" colour (light grey).
@@ -16,6 +16,9 @@ struct Rgb {
 };
 
 Rgb turbo(double t);
+// Errors: turbo without its near-black ends (0.1 .. 0.95), so a small error never reads as "dark = bad"
+// and every colour stands out on white. Used by every error figure.
+Rgb errorMap(double t);
 Rgb viridis(double t);
 Rgb grey(double t, uint8_t lo = 90, uint8_t hi = 215);
 constexpr Rgb kNoData{220, 220, 220};

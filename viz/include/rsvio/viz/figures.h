@@ -88,6 +88,7 @@ struct CompareGrid {
 CompareGrid makeCompareGrid(const std::vector<CompareRun>& runs);
 // One square per run: rows = configs, columns = sequences x runs; colour = ATE on a log scale
 // (values beyond the scale saturate, as in the paper); failed = white with a cross; colour bar right.
+// size {0, 0}: the figure is sized to the grid (squares of 16..48 px, readable labels).
 void renderCompareGrid(const CompareGrid& g, const std::string& path, FigureSize size = {});
 // Box plot of ATE per configuration over all its runs (log axis when the values span > 1 decade), every
 // run as a dot, failed runs counted under each box.

@@ -55,6 +55,7 @@ ResidualMapInput residualMapInput(const DiagnosticsLog& log);
 struct FigureLink {
   std::string path;     // file on disk
   std::string caption;
+  bool wide = false;    // spans the page's width (wide figures such as the compare grid)
 };
 
 struct CompareRenderOptions {

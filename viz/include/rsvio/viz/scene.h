@@ -2,7 +2,7 @@
 //
 // What is drawn (all in the ground truth's world when the snapshot has errors, i.e. the estimate is
 // mapped by the snapshot's alignment p_gt ~ s R p_est + t; otherwise in the estimate's own world):
-// - the estimated trajectory (every frame), coloured by position error with the turbo map (plain blue
+// - the estimated trajectory (every frame), coloured by position error (colormap.h errorMap; plain blue
 //   without ground truth), line width scaled with the image;
 // - the ground-truth trajectory (black);
 // - the sparse point cloud, grey levels from intensity (2nd..98th percentile stretched);
@@ -10,7 +10,8 @@
 // - a ground grid, a title (run, view, status, ATE), a legend, a colour bar for the error and, in the
 //   parallel top and side views, a scale bar.
 // Views: top (looking down -z, y up in the image), side (looking along +y, z up), perspective.
-// A snapshot without any geometry (a failed run) still gives each view: an image with the reason.
+// A snapshot without any geometry (a failed run) still gives a picture: the first asked view's file,
+// showing the reason (the other views are not written).
 //
 // Needs an X display: construct a viz::DisplayGuard first and check ok(). Throws rsvio::Error when VTK
 // cannot render or the PNG cannot be written.
@@ -32,11 +33,12 @@ struct SceneOptions {
   bool show_points = true;
   bool show_frusta = true;
   bool show_ground_truth = true;
-  int max_frusta = 60;              // evenly subsampled beyond this
+  int max_frusta = 30;              // evenly subsampled beyond this
   std::string file_prefix = "trajectory_";  // files are <out_dir>/<prefix><view>.png
 };
 
-// Renders every asked view; returns the written files in the order of options.views.
+// Renders every asked view; returns the written files in the order of options.views (one file when
+// there is nothing to draw).
 std::vector<std::string> renderScenes(const io::Snapshot& snapshot, const SceneOptions& options,
                                       const std::string& out_dir);
 
