@@ -110,44 +110,79 @@ const char* poseFrameName(PoseFrame f) {
   }
 }
 
+namespace {
+
+// "1.403715529112143517e+09" -> "1403715529.112143517": moves the decimal point by the exponent on the
+// digit string itself, so stamps written in exponent notation (evo does) stay exact too.
+std::optional<std::string> shiftExponent(const std::string& token) {
+  const size_t e = token.find_first_of("eE");
+  std::string mant = token.substr(0, e);
+  const std::string exp_text = token.substr(e + 1);
+  if (exp_text.empty() || exp_text.size() > 4) return std::nullopt;
+  char* end = nullptr;
+  const long exp = std::strtol(exp_text.c_str(), &end, 10);
+  if (*end != '\0') return std::nullopt;
+  std::string sign;
+  if (!mant.empty() && (mant[0] == '+' || mant[0] == '-')) {
+    sign = mant.substr(0, 1);
+    mant = mant.substr(1);
+  }
+  const size_t dot = mant.find('.');
+  std::string digits = mant;
+  long point = static_cast<long>(mant.size());
+  if (dot != std::string::npos) {
+    digits = mant.substr(0, dot) + mant.substr(dot + 1);
+    point = static_cast<long>(dot);
+  }
+  if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  point += exp;
+  if (point > 40 || point < -40) return std::nullopt;
+  if (point <= 0) return sign + "0." + std::string(static_cast<size_t>(-point), '0') + digits;
+  if (point >= static_cast<long>(digits.size())) return sign + digits + std::string(point - digits.size(), '0');
+  return sign + digits.substr(0, point) + "." + digits.substr(point);
+}
+
+}  // namespace
+
 std::optional<int64_t> parseSecondsToNs(const std::string& token) {
   if (token.empty()) return std::nullopt;
-  const bool has_exponent = token.find_first_of("eE") != std::string::npos;
-  if (!has_exponent) {
-    // Exact decimal conversion: TUM stamps carry up to 9 decimals and double would lose the last ones.
-    size_t i = 0;
-    bool negative = false;
-    if (token[i] == '+' || token[i] == '-') negative = token[i++] == '-';
-    int64_t whole = 0, frac = 0;
-    int int_digits = 0, frac_digits = 0;
-    bool round_up = false;
-    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
-      if (++int_digits > 10) return std::nullopt;  // > ~3e2 years past 1970 overflows int64 ns
-      whole = whole * 10 + (token[i++] - '0');
-    }
-    if (i < token.size() && token[i] == '.') {
-      ++i;
-      while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
-        if (frac_digits < 9) {
-          frac = frac * 10 + (token[i] - '0');
-        } else if (frac_digits == 9) {
-          round_up = token[i] >= '5';
-        }
-        ++frac_digits;
-        ++i;
-      }
-    }
-    if (i != token.size() || int_digits + frac_digits == 0) return std::nullopt;
-    for (int k = std::min(frac_digits, 9); k < 9; ++k) frac *= 10;
-    if (whole > std::numeric_limits<int64_t>::max() / 1000000000LL - 1) return std::nullopt;
-    int64_t ns = whole * 1000000000LL + frac + (round_up ? 1 : 0);
-    return negative ? -ns : ns;
+  if (token.find_first_of("eE") != std::string::npos) {
+    const auto plain = shiftExponent(token);
+    if (!plain || plain->find_first_of("eE") != std::string::npos) return std::nullopt;
+    return parseSecondsToNs(*plain);
   }
-  const char* s = token.c_str();
-  char* end = nullptr;
-  const double v = std::strtod(s, &end);
-  if (end != s + token.size() || !std::isfinite(v) || std::abs(v) > 9.2e9) return std::nullopt;
-  return sToNs(v);
+  // Exact decimal conversion: TUM stamps carry up to 9 decimals and double would lose the last ones.
+  size_t i = 0;
+  bool negative = false;
+  if (token[i] == '+' || token[i] == '-') negative = token[i++] == '-';
+  int64_t whole = 0, frac = 0;
+  int int_digits = 0, frac_digits = 0;
+  bool round_up = false;
+  while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
+    // Leading zeros (from exponent shifting) do not count towards the int64 limit.
+    if (whole > 0 || token[i] != '0') {
+      if (++int_digits > 10) return std::nullopt;  // > 9.2e9 s does not fit int64 nanoseconds
+    }
+    whole = whole * 10 + (token[i++] - '0');
+  }
+  const bool had_int = i > (negative || token[0] == '+' ? 1u : 0u);
+  if (i < token.size() && token[i] == '.') {
+    ++i;
+    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
+      if (frac_digits < 9) {
+        frac = frac * 10 + (token[i] - '0');
+      } else if (frac_digits == 9) {
+        round_up = token[i] >= '5';
+      }
+      ++frac_digits;
+      ++i;
+    }
+  }
+  if (i != token.size() || (!had_int && frac_digits == 0)) return std::nullopt;
+  for (int k = std::min(frac_digits, 9); k < 9; ++k) frac *= 10;
+  if (whole > std::numeric_limits<int64_t>::max() / 1000000000LL - 1) return std::nullopt;
+  const int64_t ns = whole * 1000000000LL + frac + (round_up ? 1 : 0);
+  return negative ? -ns : ns;
 }
 
 std::string formatSeconds(int64_t t) {
