@@ -1,6 +1,7 @@
 // The schema of `rsvio run` configs. Plugin slots validate their params against the plugin's own table;
 // sections here validate against the tables of the framework subsystems that own them.
 #include "rsvio/config/validate.h"
+#include "rsvio/frontend/frontend_options.h"
 
 namespace rsvio {
 
@@ -17,6 +18,7 @@ ConfigSchema runConfigSchema() {
   s.slot("solver", PluginKind::Solver, "solver.dense", "linear solver of the Gauss-Newton steps");
   s.multiSlot("photometric", PluginKind::Photometric, "photometric model terms, keyed by name");
   s.multiSlot("motion", PluginKind::Motion, "motion priors, keyed by name");
+  s.section("frontend", frontendParamTable(), "photometric front end: pyramid, point selection, tracking");
   s.section("output",
             {paramBool("render", true, "render figures and index.html at the end of the run"),
              paramBool("diagnostics", true, "write diagnostics.bin for rsvio diagnose"),
