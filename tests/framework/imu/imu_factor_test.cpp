@@ -71,6 +71,17 @@ TEST(ImuFactor, ZeroResidualAtTruth) {
   EXPECT_EQ(r.tail<6>().norm(), 0.0);
 }
 
+TEST(ImuFactor, PredictStateReachesTheNextStateAndZeroesTheResidual) {
+  Fixture f;
+  const ImuState si = f.tr.state(f.ti, f.bias_lin);
+  const ImuState pred = predictState(si, f.factor.preintegration());
+  const ImuState truth = f.tr.state(f.tj, f.bias_lin);
+  EXPECT_LT((pred.R_w_i.inverse() * truth.R_w_i).log().norm(), 2e-6);
+  EXPECT_LT((pred.v_w - truth.v_w).norm(), 5e-5);
+  EXPECT_LT((pred.p_w_i - truth.p_w_i).norm(), 5e-5);
+  EXPECT_LT(f.factor.residual(si, pred).norm(), 1e-12);  // eqs. 13-15 are what eqs. 16-19 compare against
+}
+
 TEST(ImuFactor, JacobiansMatchNumeric) {
   Fixture f;
   std::mt19937_64 rng(3);
