@@ -168,7 +168,7 @@ TEST_F(RenderRunTest, RenderCommand) {
   test::TempDir tmp("cli");
   const auto run = test::makeRun(tmp.path, test::RunSpec{});
   const std::string out = (tmp.path / "out").string();
-  const std::string cmd = std::string(bin) + " render --run " + run.string() + " --out " + out + " > " +
+  const std::string cmd = std::string(bin) + " render --run " + run.string() + " --out " + out + " --width 320 --height 240 > " +
                           (tmp.path / "log.txt").string() + " 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(tmp.path / "log.txt");
   EXPECT_TRUE(fs::exists(fs::path(out) / "trajectory_top.png"));
