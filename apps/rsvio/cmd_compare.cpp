@@ -9,6 +9,9 @@
 #include "commands.h"
 #include "rsvio/core/error.h"
 #include "rsvio/eval/compare.h"
+#ifdef RSVIO_HAVE_VIZ
+#include "rsvio/viz/render_run.h"
+#endif
 
 namespace rsvio::app {
 namespace {
@@ -20,7 +23,36 @@ struct CompareArgs {
   double timeout_s = 3600;
   std::string out;
   std::string runner;  // hidden: a program used instead of this binary (tests, scripts)
+  bool no_figures = false;
 };
+
+// The grid figure and page (viz, when built): never throws, a problem is one line on stderr.
+void renderFigures(const CompareArgs& a, const eval::CompareResult& result, int verbosity) {
+#ifdef RSVIO_HAVE_VIZ
+  std::vector<viz::CompareRun> runs;
+  for (const auto& x : result.runs) {
+    viz::CompareRun c;
+    c.config = x.job.config_name;
+    c.sequence = x.job.dataset_name;
+    c.run = x.job.run;
+    c.failed = !x.ok;
+    if (x.ate_rmse_m) c.ate_m = *x.ate_rmse_m;
+    c.run_dir = x.job.out_dir;
+    c.error = x.error;
+    runs.push_back(c);
+  }
+  viz::CompareRenderOptions opt;
+  opt.out_dir = a.out;
+  opt.notes.push_back("ATE: report.json eval.ate_rmse_m, else keyframes.tum against the dataset's ground truth");
+  const auto status = viz::renderCompare(runs, opt);
+  if (!status.ok) std::cerr << "rsvio compare: figures: " << status.message << "\n";
+  if (verbosity > 0 && !status.index_html.empty()) std::cout << "page: " << status.index_html << "\n";
+#else
+  (void)a;
+  (void)result;
+  (void)verbosity;
+#endif
+}
 
 std::string thisBinary() {
   std::error_code ec;
@@ -62,6 +94,7 @@ int runCompareCommand(const CompareArgs& a, const GlobalOptions& g) {
   std::cout << "\n" << eval::formatCompareTable(result);
   std::cout << "written: " << (fs::path(a.out) / "compare.csv").string() << ", "
             << (fs::path(a.out) / "compare.json").string() << "\n";
+  if (!a.no_figures) renderFigures(a, result, g.verbosity);
   return result.failed() == 0 ? 0 : 1;
 }
 
@@ -81,6 +114,7 @@ void addCompareCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r)
   // Hidden (empty group): replaces `<this binary>` as the child program; it gets the same arguments
   // ("run --config C --data D --out O --seed k"). For tests and scripts with a stand-in runner.
   sub->add_option("--runner", args->runner, "program to run instead of this binary")->group("");
+  sub->add_flag("--no-figures", args->no_figures, "skip the grid figures and index.html (drawn when viz is built)");
   sub->callback([args, &g, &r] { r.exit_code = runCompareCommand(*args, g); });
 }
 
