@@ -88,8 +88,14 @@ int runCompareCommand(const CompareArgs& a, const GlobalOptions& g) {
               << " datasets x " << a.runs << " seeds), " << a.jobs << " at a time, into " << a.out << "/runs\n";
   }
   const auto result = eval::runCompare(jobs, builder, opt, g.verbosity > 0 ? &std::cout : nullptr);
-  const nlohmann::json invocation = {{"configs", a.configs}, {"data", a.datasets}, {"runs", a.runs},
-                                     {"jobs", a.jobs},       {"timeout_s", a.timeout_s}};
+  // Absolute paths, so the grid can be run again from anywhere (scripts/reproduce_compare.sh --from).
+  auto absolute = [](const std::vector<std::string>& v) {
+    std::vector<std::string> out;
+    for (const auto& p : v) out.push_back(fs::absolute(p).lexically_normal().string());
+    return out;
+  };
+  const nlohmann::json invocation = {{"configs", absolute(a.configs)}, {"data", absolute(a.datasets)},
+                                     {"runs", a.runs}, {"jobs", a.jobs}, {"timeout_s", a.timeout_s}};
   eval::writeCompareOutputs(a.out, result, invocation);
   std::cout << "\n" << eval::formatCompareTable(result);
   std::cout << "written: " << (fs::path(a.out) / "compare.csv").string() << ", "
