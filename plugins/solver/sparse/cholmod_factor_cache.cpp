@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstring>
 #include <sstream>
 
@@ -73,6 +74,40 @@ bool CholmodFactorCache::loadUpper(const Eigen::SparseMatrix<double>& H) {
          std::memcmp(A_->i, i_.data(), i_.size() * sizeof(int)) == 0;
 }
 
+bool CholmodFactorCache::pivotsOk(std::ostringstream& os) {
+  if (!L_->is_super && !L_->is_ll) {
+    // Simplicial LDL' does not pivot and CHOLMOD accepts negative entries of D (it factors some
+    // indefinite matrices), so the sign test is ours: D(j) is the first entry of column j.
+    const int* Lp = static_cast<const int*>(L_->p);
+    const double* Lx = static_cast<const double*>(L_->x);
+    double dmin = INFINITY, dmax = 0.0;
+    size_t j_min = 0;
+    for (size_t j = 0; j < L_->n; ++j) {
+      const double d = Lx[Lp[j]];
+      if (!(d >= dmin)) {
+        dmin = d;
+        j_min = j;
+      }
+      dmax = std::max(dmax, std::abs(d));
+    }
+    if (!(dmax > 0.0) || !(dmin > options_.min_pivot_ratio * dmax)) {
+      os << "H is not positive definite (LDL' pivot " << j_min << " of " << L_->n
+         << " in the fill-reducing order = " << dmin << ", largest " << dmax << ", min_pivot_ratio "
+         << options_.min_pivot_ratio << ")";
+      return false;
+    }
+    return true;
+  }
+  // LL' (CHOLMOD stops at a non-positive pivot): rcond = (min/max diag(L))^2, the pivot ratio of solver.dense.
+  const double rcond = cholmod_rcond(L_, &c_);
+  if (!(rcond > options_.min_pivot_ratio)) {
+    os << "H is not positive definite (smallest pivot / largest = " << rcond << " <= min_pivot_ratio "
+       << options_.min_pivot_ratio << ")";
+    return false;
+  }
+  return true;
+}
+
 bool CholmodFactorCache::solve(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, Eigen::VectorXd& x,
                                std::string& why) {
   std::ostringstream os;
@@ -119,11 +154,7 @@ bool CholmodFactorCache::solve(const Eigen::SparseMatrix<double>& H, const Eigen
     why = "CHOLMOD's factorisation failed (status " + std::to_string(c_.status) + ")";
     return false;
   }
-  // CHOLMOD's rcond is (min/max) of D for LDL' and of diag(L)^2 for LL': the pivot ratio, as in solver.dense.
-  const double rcond = cholmod_rcond(L_, &c_);
-  if (!(rcond > options_.min_pivot_ratio)) {
-    os << "H is not positive definite (smallest pivot / largest = " << rcond << " <= min_pivot_ratio "
-       << options_.min_pivot_ratio << ")";
+  if (!pivotsOk(os)) {
     why = os.str();
     return false;
   }

@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,8 @@ class CholmodFactorCache {
   // Copies the upper triangle of H into the scratch arrays; true when its pattern equals the cached A_'s.
   bool loadUpper(const Eigen::SparseMatrix<double>& H);
   void release();
+  // Every pivot of the fresh factor > min_pivot_ratio times the largest; else a reason into os.
+  bool pivotsOk(std::ostringstream& os);
 
   CholmodOptions options_;
   cholmod_common c_;
