@@ -12,11 +12,13 @@
 //                               "line_delay_s": 2e-5, "readout": "top_down"}}]}
 // Missing calibration fields take the values of defaultContractCalibration().
 //
-// Usage (one instantiation per kind, in tests/plugins/<kind>/):
-//   class CameraContract : public ::testing::TestWithParam<rsvio::test::ContractCase> {};
-//   TEST_P(CameraContract, RoundTrip) { rsvio::test::checkCameraRoundTrip(*makeCamera(GetParam())); }
-//   INSTANTIATE_TEST_SUITE_P(AllCameras, CameraContract,
-//       ::testing::ValuesIn(rsvio::test::contractCases(rsvio::PluginKind::Camera)), rsvio::test::contractCaseName);
+// The suites are instantiated once per kind in tests/plugins/<kind>/*_contract_test.cpp, e.g.
+//   class CameraContract : public ::testing::TestWithParam<ContractCase> {};
+//   TEST_P(CameraContract, RoundTrip) { checkCameraRoundTrip(*makeContractPlugin<CameraModel>(GetParam())); }
+//   INSTANTIATE_TEST_SUITE_P(AllCameraPlugins, CameraContract,
+//                            ::testing::ValuesIn(contractCases(PluginKind::Camera, true)), contractCaseName);
+// so a new plugin of a kind runs them by being built; nothing to add. A new kind adds its checks here.
+// Plugin-specific tests use makePlugin<I>(name, params) the same way.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -25,10 +27,11 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCore>
 #include <cctype>
-#include <random>
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -379,6 +382,7 @@ inline void checkSolverRejectsIndefinite(SolverBackend& solver) {
   singular.col(4).setZero();
   const Eigen::VectorXd b = Eigen::VectorXd::Ones(5);
   for (const Eigen::MatrixXd* H : std::vector<const Eigen::MatrixXd*>{&indefinite, &singular}) {
+    SCOPED_TRACE(H == &indefinite ? "indefinite H (eigenvalue -0.5)" : "singular H (last row and column 0)");
     Eigen::VectorXd x;
     SolverStats stats;
     EXPECT_FALSE(solver.solveDense(*H, b, x, &stats)) << *H;
