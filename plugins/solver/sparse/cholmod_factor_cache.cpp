@@ -15,7 +15,10 @@ CholmodFactorCache::CholmodFactorCache(const CholmodOptions& options) : options_
   c_.print = 0;
   c_.error_handler = nullptr;
   switch (options_.method) {
-    case FactorMethod::Auto: c_.supernodal = CHOLMOD_AUTO; break;
+    case FactorMethod::Auto:
+      c_.supernodal = CHOLMOD_AUTO;
+      c_.supernodal_switch = options_.supernodal_switch;
+      break;
     case FactorMethod::Supernodal: c_.supernodal = CHOLMOD_SUPERNODAL; break;
     case FactorMethod::Simplicial: c_.supernodal = CHOLMOD_SIMPLICIAL; break;
   }
@@ -135,6 +138,7 @@ bool CholmodFactorCache::solve(const Eigen::SparseMatrix<double>& H, const Eigen
       return false;
     }
     ++analyses_;
+    last_fl_per_lnz_ = c_.lnz > 0.0 ? c_.fl / c_.lnz : 0.0;
   }
   std::memcpy(A_->x, x_.data(), x_.size() * sizeof(double));
 

@@ -31,6 +31,7 @@ struct CholmodOptions {
   FactorMethod method = FactorMethod::Auto;
   Ordering ordering = Ordering::Amd;
   double min_pivot_ratio = 1e-14;
+  double supernodal_switch = 1000.0;  // Auto: supernodal when flops / nnz(L) >= this (CHOLMOD's own is 40)
 };
 
 class CholmodFactorCache {
@@ -47,6 +48,7 @@ class CholmodFactorCache {
   long factorizations() const { return factorizations_; }  // numeric factorizations done
   bool lastWasSupernodal() const { return last_supernodal_; }
   double lastFactorNonZeros() const { return last_nnz_l_; }  // entries of L (CHOLMOD's lnz)
+  double lastFlopsPerNonZero() const { return last_fl_per_lnz_; }  // CHOLMOD's fl / lnz, what Auto decides on
 
  private:
   // Copies the upper triangle of H into the scratch arrays; true when its pattern equals the cached A_'s.
@@ -66,6 +68,7 @@ class CholmodFactorCache {
   long factorizations_ = 0;
   bool last_supernodal_ = false;
   double last_nnz_l_ = 0.0;
+  double last_fl_per_lnz_ = 0.0;
 };
 
 }  // namespace rsvio::sparse

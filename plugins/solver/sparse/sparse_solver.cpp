@@ -12,7 +12,7 @@
 // evict the cached analysis of the full system.
 //
 // On success SolverStats::message reports the factor kind and the counters
-//   "solver.sparse: supernodal LL', n = 1234, nnz(L) = 56789, analyses 1, factorizations 3"
+//   "solver.sparse: simplicial LDL', n = 1234, nnz(L) = 56789, flops/nnz(L) = 42, analyses 1, factorizations 3"
 // so callers and tests can see that repeated solves with one pattern reuse one analysis.
 #include <Eigen/Cholesky>
 #include <chrono>
@@ -50,6 +50,7 @@ sparse::CholmodOptions optionsFrom(const Params& p) {
                : ord == "best"    ? sparse::Ordering::Best
                                   : sparse::Ordering::Amd;
   o.min_pivot_ratio = p.getDouble("min_pivot_ratio");
+  o.supernodal_switch = p.getDouble("supernodal_switch");
   return o;
 }
 
@@ -80,7 +81,8 @@ class SparseSolver : public SolverBackend {
         os << why;
       } else {
         os << (cache_.lastWasSupernodal() ? "supernodal LL'" : "simplicial LDL'") << ", n = " << H.rows()
-           << ", nnz(L) = " << static_cast<long>(cache_.lastFactorNonZeros());
+           << ", nnz(L) = " << static_cast<long>(cache_.lastFactorNonZeros())
+           << ", flops/nnz(L) = " << static_cast<long>(cache_.lastFlopsPerNonZero());
       }
       os << ", analyses " << cache_.analyses() << ", factorizations " << cache_.factorizations();
       msg = os.str();
@@ -163,7 +165,11 @@ class SparseSolver : public SolverBackend {
 
 ParamTable sparseParams() {
   return {paramEnum("method", "auto", {"auto", "supernodal", "simplicial"},
-                    "CHOLMOD factor kind: auto (CHOLMOD picks by flops per nnz(L)), supernodal LL', simplicial LDL'"),
+                    "CHOLMOD factor kind: auto (supernodal when flops/nnz(L) >= supernodal_switch), supernodal LL', "
+                    "simplicial LDL'"),
+          paramDouble("supernodal_switch", 1000.0, 0.0, 1e9, "flops per nnz(L)",
+                      "method auto picks supernodal at or above this; CHOLMOD's own 40 lost on every BA shape of "
+                      "bench/solver_bench.cpp (flops/nnz(L) <= 64 there)"),
           paramEnum("ordering", "amd", {"amd", "metis", "natural", "best"},
                     "fill-reducing ordering: amd, metis, natural (none), best (CHOLMOD tries AMD then METIS)"),
           paramBool("full_system", true,
