@@ -8,6 +8,8 @@
 //   SparseFull       solver.sparse on the full system, analysis cached (the steady state: every
 //                    iteration of one window has the same pattern).
 //   SparseFullFresh  the same with a new analysis per call (the first iteration of a new window).
+//   SparseSimplicial / SparseSupernodal  the cached solve with the factor kind forced (what auto chooses from).
+// Compare CPU times: the label shows the factor kind, nnz(L) and flops/nnz(L) of the sparse solves.
 // Plugins load through the host like the app's: $RSVIO_PLUGIN_PATH, else <bin>/plugins.
 // Run: <build>/bin/solver_bench [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
