@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rsvio/sim/rng.h"
 
 namespace rsvio::sim {
 
@@ -85,8 +84,13 @@ float TextureMap::sample(double s_m, double t_m, double footprint_m) const {
 }
 
 double hash01(int64_t a, int64_t b, uint64_t seed) {
-  const uint64_t h = mix64(seed ^ mix64(static_cast<uint64_t>(a) * 0x9E3779B97F4A7C15ull ^
-                                        static_cast<uint64_t>(b) * 0xC2B2AE3D27D4EB4Full));
+  // Two multiply-xorshift rounds: enough mixing for lattice noise, and the hot spot of texture painting.
+  uint64_t h = seed ^ (static_cast<uint64_t>(a) * 0x9E3779B97F4A7C15ull) ^ (static_cast<uint64_t>(b) * 0xC2B2AE3D27D4EB4Full);
+  h ^= h >> 32;
+  h *= 0xD6E8FEB86659FD93ull;
+  h ^= h >> 32;
+  h *= 0xD6E8FEB86659FD93ull;
+  h ^= h >> 32;
   return static_cast<double>(h >> 11) * 0x1.0p-53;
 }
 

@@ -221,6 +221,25 @@ SimTrajectory SimTrajectory::generate(const MotionSpec& spec, std::mt19937_64& r
         << " deg/s cannot be reached within motion.max_pitch_deg / max_roll_deg; lower it or raise the limits";
     throw ConfigError(msg.str());
   }
+  // The bands can only mix two frequency ranges: a target outside what they reach (or a room too small
+  // for it) leaves a statistic off. Say which, instead of writing a sequence that is not what was asked.
+  const MotionStats st = tr.stats(100.0);
+  const struct {
+    const char* key;
+    double asked, got;
+  } checks[] = {{"mean_speed_m_s", spec.mean_speed_m_s, st.mean_speed_m_s},
+                {"mean_accel_m_s2", spec.mean_accel_m_s2, st.mean_accel_m_s2},
+                {"mean_rot_speed_deg_s", spec.mean_rot_speed_deg_s, st.mean_rot_speed_deg_s},
+                {"mean_rot_accel_deg_s2", spec.mean_rot_accel_deg_s2, st.mean_rot_accel_deg_s2}};
+  for (const auto& c : checks) {
+    if (std::abs(c.got - c.asked) > 0.1 * c.asked) {
+      std::ostringstream msg;
+      msg << "motion." << c.key << ": asked " << c.asked << ", the closest path that fits the room and the other "
+          << "targets reaches " << c.got << "; make the speed and acceleration targets more compatible "
+          << "(acceleration / speed between about 0.3 and 6 per second)";
+      throw ConfigError(msg.str());
+    }
+  }
   return tr;
 }
 
