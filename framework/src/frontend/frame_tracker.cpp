@@ -24,6 +24,7 @@ void FrameTracker::setReference(const TrackingReference& reference) {
   if (!reference.pyramid || reference.pyramid->numLevels() == 0)
     throw Error("FrameTracker::setReference: reference keyframe has no image pyramid");
   ref_ = reference;
+  first_rmse_ = std::nan("");
   const ImagePyramid& pyr = *ref_.pyramid;
   const int num_levels = std::min(options_.max_levels, pyr.numLevels());
   levels_.clear();
@@ -68,7 +69,8 @@ void FrameTracker::setReference(const TrackingReference& reference) {
       if (!makePatternHost(img, static_cast<float>(cell[i].x()), static_cast<float>(cell[i].y()), ro, &host)) continue;
       // Fixed in the world at the host row's capture time (eq. 6 at t(v_h), eq. 7).
       const double t_h = timing_.rowTime(uv0[i].y());
-      const Vec3 Z = SE3d::exp(-ref_.twist * t_h) * Vec3(bearing.col(static_cast<Eigen::Index>(i)) / idepth[i]);
+      const Vec3 Z_c = bearing.col(static_cast<Eigen::Index>(i)) / idepth[i];
+      const Vec3 Z = t_h == 0.0 ? Z_c : Vec3(SE3d::exp(-ref_.twist * t_h) * Z_c);
       X.push_back(T_w_h0 * Z);
       L->host.push_back(host);
       L->host_uv0.push_back(uv0[i]);

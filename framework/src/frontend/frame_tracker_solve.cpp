@@ -174,6 +174,7 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
   } else {
     res.status = TrackResult::Status::Ok;
     last_rmse_ = best.level_rmse;
+    if (std::isnan(first_rmse_)) first_rmse_ = best.level_rmse[0];
   }
 
   // DSO's flow indicators on the level-0 points, central poses.

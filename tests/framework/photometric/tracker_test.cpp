@@ -87,6 +87,7 @@ TEST(FrameTracker, ConvergesWithinTheStatedBasin) {
     EXPECT_GT(r.inlier_ratio, 0.9);
     EXPECT_LT(r.rmse, 4.0);
     EXPECT_GT(r.flow_rt_px, 1.0);
+    EXPECT_TRUE(std::isfinite(tracker.firstRmse()));
   }
 }
 
@@ -217,9 +218,14 @@ TEST(FrameTracker, ResultsIdenticalForOneAndTwoThreads) {
 }
 
 TEST(FrameTracker, NoReferenceIsAnError) {
-  const Fixture& f = fixture();
-  FrameTracker t(TrackerOptions(), f.camera, RowTiming::global(127.5));
-  EXPECT_THROW(t.track(*f.new_pyr, TrackingFrame(), {}), Error);
+  const test::PinholeK K;
+  const test::TestPinholeCamera camera(K);
+  FrameTracker t(TrackerOptions(), camera, RowTiming::global(127.5));
+  const ImagePyramid pyr(cv::Mat(K.height, K.width, CV_32F, cv::Scalar(100.0)), 3);
+  EXPECT_FALSE(t.hasReference());
+  EXPECT_THROW(t.track(pyr, TrackingFrame(), {}), Error);
+  TrackingReference empty;
+  EXPECT_THROW(t.setReference(empty), Error);  // no pyramid
 }
 
 }  // namespace

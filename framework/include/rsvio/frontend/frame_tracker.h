@@ -29,6 +29,7 @@
 //   result is identical for 1 and 2 threads (at most 2 are used).
 #pragma once
 #include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -135,6 +136,9 @@ class FrameTracker {
 
   // RMSE per level of the last successful track (DSO's lastCoarseRMSE); NaN before the first.
   const std::array<double, 6>& lastRmse() const { return last_rmse_; }
+  // Level-0 RMSE of the first successful track since setReference() (DSO's firstCoarseRMSE: a frame
+  // whose RMSE exceeds twice this calls for a keyframe); NaN until then.
+  double firstRmse() const { return first_rmse_; }
 
   const TrackerOptions& options() const { return options_; }
 
@@ -166,6 +170,7 @@ class FrameTracker {
   TrackingReference ref_;
   std::vector<std::unique_ptr<LevelPoints>> levels_;
   std::array<double, 6> last_rmse_;
+  double first_rmse_ = std::nan("");
   std::unique_ptr<BlockRunner> runner_;
 };
 
