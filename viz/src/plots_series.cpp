@@ -97,7 +97,25 @@ void renderErrorOverTime(const ErrorSeries& e, const std::string& path, FigureSi
   p.x_label = "time [s]";
   p.y_label = "position error [m]";
   p.y_from_zero = true;
-  p.series.push_back(Series{"error after alignment", e.t_s, e.err_m, kBlue});
+  // Break the line over gaps in the estimate (more than 5x the median step), so a stretch without poses
+  // is not drawn as a steep straight line.
+  Series s{"error after alignment", {}, {}, kBlue};
+  std::vector<double> steps;
+  for (size_t i = 1; i < e.t_s.size(); ++i) steps.push_back(e.t_s[i] - e.t_s[i - 1]);
+  double median_step = 0;
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    median_step = steps[steps.size() / 2];
+  }
+  for (size_t i = 0; i < std::min(e.t_s.size(), e.err_m.size()); ++i) {
+    if (i > 0 && median_step > 0 && e.t_s[i] - e.t_s[i - 1] > 5 * median_step) {
+      s.x.push_back(kNaN);
+      s.y.push_back(kNaN);
+    }
+    s.x.push_back(e.t_s[i]);
+    s.y.push_back(e.err_m[i]);
+  }
+  p.series.push_back(std::move(s));
   if (std::isfinite(e.ate_rmse_m)) p.hlines.emplace_back("ATE RMSE " + formatNumber(e.ate_rmse_m) + " m", e.ate_rmse_m);
   renderPanels({p}, e.message.empty() ? "no trajectory errors (no ground truth?)" : e.message, path, size);
 }
