@@ -12,7 +12,7 @@ bool renderRunOutputs(const std::string& run_dir, int verbosity) {
 #ifdef RSVIO_HAVE_VIZ
   viz::RenderStatus st = viz::renderRunFolder(run_dir);
   if (!st.ok) {
-    std::cerr << "rsvio: render incomplete: " << st.message << "\n";
+    std::cerr << "rsvio: " << st.message << "\n";
     for (const auto& p : st.problems) std::cerr << "  " << p << "\n";
   } else if (verbosity >= 1) {
     std::cout << "figures: " << st.index_html << "\n";
