@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <unistd.h>
 
 #include "commands.h"
 #include "rsvio/plugin/host.h"
@@ -39,16 +40,16 @@ int runSimulate(const SimulateOptions& o, const GlobalOptions& g) {
                  effects.empty() ? "none" : effects.c_str());
   }
   double last_print = -1.0;
+  const bool tty = isatty(fileno(stderr)) != 0;  // a log file gets one line per update, a terminal one line
   auto progress = [&](const sim::SimProgress& p) {
     if (g.verbosity <= 0) return;
     if (p.stage == "scene" && p.done == 0) {
       std::fprintf(stderr, "  building the scene ...\n");
     } else if (p.stage == "frames") {
-      if (p.elapsed_s - last_print < 1.0 && p.done != p.total) return;
+      if (p.elapsed_s - last_print < (tty ? 0.5 : 5.0) && p.done != p.total) return;
       last_print = p.elapsed_s;
-      std::fprintf(stderr, "\r  images %lld/%lld  %.1f s", static_cast<long long>(p.done), static_cast<long long>(p.total),
-                   p.elapsed_s);
-      if (p.done == p.total) std::fprintf(stderr, "\n");
+      std::fprintf(stderr, "%s  images %lld/%lld  %.1f s%s", tty ? "\r" : "", static_cast<long long>(p.done),
+                   static_cast<long long>(p.total), p.elapsed_s, tty && p.done != p.total ? "" : "\n");
     }
   };
   const auto t0 = std::chrono::steady_clock::now();

@@ -97,8 +97,7 @@ void Renderer::renderRows(double t_capture_s, int row_begin, int row_end, cv::Ma
   std::vector<Mat3> R(poses);
   std::vector<Vec3> o(poses);
   std::vector<std::vector<Candidate>> cand(poses);
-  std::vector<int> list;
-  list.reserve(scene_.numSolids());
+  std::vector<int> list(scene_.numSolids());
   for (int y = row_begin; y < row_end; ++y) {
     const double t_row = t_capture_s + sensor_.rowTime(y);
     // Ray k of a pixel: spatial subsample k % n at time sample k (spread over the exposure).
@@ -117,13 +116,13 @@ void Renderer::renderRows(double t_capture_s, int row_begin, int row_end, cv::Ma
         const int pk = blur ? k : 0;
         const size_t idx = row_base + static_cast<size_t>(x) * n + (k % n);
         const float xn = xn_[idx];
-        list.clear();
+        int n_list = 0;
         for (const Candidate& c : cand[pk])
-          if (xn >= c.xn_lo && xn <= c.xn_hi) list.push_back(c.solid);
+          if (xn >= c.xn_lo && xn <= c.xn_hi) list[n_list++] = c.solid;
         const Vec3 d = R[pk] * rays_[idx].cast<double>();
         Scene::Hit hit;
-        if (!scene_.intersect(o[pk], d, hit, list.data(), static_cast<int>(list.size()))) continue;
-        const double cos_in = std::abs(scene_.normal(hit).dot(d));
+        if (!scene_.intersect(o[pk], d, hit, list.data(), n_list)) continue;
+        const double cos_in = std::abs(d[hit.face / 2]);  // faces are axis-aligned, d is a unit vector
         sum += scene_.radiance(hit, hit.t * ray_angle_ / std::max(cos_in, 0.25));
       }
       row[x] = static_cast<float>(sum / m);

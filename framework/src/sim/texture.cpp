@@ -68,9 +68,20 @@ float TextureMap::bilinear(int level, double x, double y) const {
   return top + ay * (bot - top);
 }
 
+namespace {
+// log2 for x >= 1, exact at powers of two and linear in between: the mip level only needs to be
+// continuous and monotone, and libm's log2 was a visible share of the render time.
+double fastLog2(double x) {
+  int e;
+  const double m = std::frexp(x, &e);  // x = m 2^e, m in [0.5, 1)
+  return (e - 1) + (2.0 * m - 1.0);
+}
+}  // namespace
+
 float TextureMap::sample(double s_m, double t_m, double footprint_m) const {
   if (levels_.size() == 1 && w_[0] == 1 && h_[0] == 1) return levels_[0][0];
-  const double lod = std::log2(std::max(footprint_m / texel_m_, 1.0));
+  const double ratio = footprint_m / texel_m_;
+  const double lod = ratio > 1.0 ? fastLog2(ratio) : 0.0;
   const int last = static_cast<int>(levels_.size()) - 1;
   const int l0 = std::min(static_cast<int>(lod), last);
   const int l1 = std::min(l0 + 1, last);
