@@ -91,6 +91,83 @@ void FrameTracker::setReference(const TrackingReference& reference) {
   }
 }
 
+void FrameTracker::resetRows() const {
+  for (const auto& L : levels_)
+    for (Block& B : L->blocks) B.row.clear();
+}
+
+// Projection of a block into the target with d uv / d T0 (left perturbation of the central pose).
+// Global shutter: one batch projection. Rolling shutter: Newton on the row as rs_projection.h
+// (v <- v + (pi_v - v) / (1 - a_v), a = J (xi_v + xi_w x P) dt/dv) with only the Jacobian the tracker
+// needs, d uv / d T0 = M J R(xi t) [I, -[P0]x], M = (I - a e_v^T)^-1, and the row of the previous
+// evaluation as the start (reset for every guess).
+void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize) const {
+  const Eigen::Index n = B.X_w.cols();
+  const Eigen::Matrix3d R = target.T_c_w0.rotationMatrix();
+  const Vec3 t = target.T_c_w0.translation();
+  B.P0.resize(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) B.P0.col(i) = R * B.X_w.col(i) + t;
+  if (linearize) B.D.resize(static_cast<size_t>(n));
+  const double c = timing_.dtDv();
+  if (c == 0.0) {
+    camera_.project(B.P0, B.uv, B.valid, linearize ? &B.J : nullptr);
+    if (linearize)
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (B.valid[static_cast<size_t>(i)]) B.D[static_cast<size_t>(i)] = B.J[static_cast<size_t>(i)] * dLeftAction(B.P0.col(i));
+    return;
+  }
+  const Vec3 xi_v = target.xi.head<3>(), xi_w = target.xi.tail<3>();
+  if (B.row.size() != static_cast<size_t>(n)) B.row.assign(static_cast<size_t>(n), timing_.y0);
+  B.uv.resize(2, n);
+  B.valid.assign(static_cast<size_t>(n), 0);
+  B.active.resize(static_cast<size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) B.active[static_cast<size_t>(i)] = static_cast<int>(i);
+  for (int it = 0; it < kRowMaxIterations && !B.active.empty(); ++it) {
+    const Eigen::Index m = static_cast<Eigen::Index>(B.active.size());
+    B.P.resize(3, m);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const int i = B.active[static_cast<size_t>(k)];
+      const double ti = timing_.rowTime(B.row[static_cast<size_t>(i)]);
+      B.P.col(k) = SE3d::exp(target.xi * ti) * Vec3(B.P0.col(i));  // eq. 6 at the row's time (eq. 7)
+    }
+    camera_.project(B.P, B.uv_a, B.valid_a, &B.J);
+    B.still.clear();
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const int i = B.active[static_cast<size_t>(k)];
+      const size_t si = static_cast<size_t>(i);
+      if (!B.valid_a[static_cast<size_t>(k)]) continue;
+      const Jac23& J = B.J[static_cast<size_t>(k)];
+      const Vec3 Pk = B.P.col(k);
+      const Vec2 a = J * (xi_v + xi_w.cross(Pk)) * c;
+      const double denom = 1.0 - a.y();
+      if (std::abs(denom) < 1e-3) continue;  // no unique row
+      const double res = B.uv_a(1, k) - B.row[si];
+      const double step = res / denom;  // Newton step on the row
+      if (std::abs(step) > kRowLinearStepPx) {
+        B.row[si] += step;
+        B.still.push_back(i);
+        continue;
+      }
+      // Small step: the solution is the linearisation uv + a step (error ~ step^2 x the curvature of
+      // the projection in time: < 1e-6 px for 0.05 rows at any realistic motion), which saves a camera
+      // call per point in most LM steps.
+      const double ti = timing_.rowTime(B.row[si]);
+      B.row[si] += step;
+      B.uv.col(i) = B.uv_a.col(k) + a * step;
+      B.valid[si] = 1;
+      if (linearize) {
+        Mat26 D = J * SO3d::exp(xi_w * ti).matrix() * dLeftAction(B.P0.col(i));
+        const double inv = 1.0 / denom;
+        D.row(0) += (a.x() * inv) * D.row(1);
+        D.row(1) *= inv;
+        B.D[si] = D;
+      }
+    }
+    B.active.swap(B.still);
+  }
+  for (int i : B.active) B.row[static_cast<size_t>(i)] = timing_.y0;  // not converged: restart next time
+}
+
 void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
                             double exposure_ratio, double cutoff, bool linearize, Linearization& out) const {
   LevelPoints& L = *levels_[static_cast<size_t>(level)];
@@ -100,9 +177,6 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
   const float inv_scale = 1.f / img.scale();
   const float cut = static_cast<float>(cutoff);
   const float sat_energy_unit = huberEnergy(cut, kernel.huber);
-  const bool global = timing_.dtDv() == 0.0;
-  const Eigen::Matrix3d R = target.T_c_w0.rotationMatrix();
-  const Vec3 t = target.T_c_w0.translation();
   const float warp[4] = {1.f, 0.f, 0.f, 1.f};
 
   auto runBlock = [&](int bi) {
@@ -110,27 +184,11 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
     Linearization& acc = B.lin;
     acc.setZero();
     const Eigen::Index n = B.X_w.cols();
-    // Geometry of the block: uv (level 0) and d uv / d T0 (left perturbation).
-    if (global) {
-      B.P.resize(3, n);
-      for (Eigen::Index i = 0; i < n; ++i) B.P.col(i) = R * B.X_w.col(i) + t;
-      camera_.project(B.P, B.uv, B.valid, linearize ? &B.J : nullptr);
-    } else {
-      RsProjectionOptions po;
-      po.jacobians = linearize;
-      projectRollingShutter(camera_, timing_, target, B.X_w, B.proj, po);
-    }
+    projectBlock(B, target, linearize);  // uv (level 0) and d uv / d T0
     PatternResidual res;
     for (Eigen::Index i = 0; i < n; ++i) {
-      Vec2 uv;
-      if (global) {
-        if (!B.valid[static_cast<size_t>(i)]) continue;
-        uv = B.uv.col(i);
-      } else {
-        const RsProjection& pr = B.proj[static_cast<size_t>(i)];
-        if (!pr.valid) continue;
-        uv = pr.uv;
-      }
+      if (!B.valid[static_cast<size_t>(i)]) continue;
+      const Vec2 uv = B.uv.col(i);
       const float u = img.toLevel(static_cast<float>(uv.x()));
       const float v = img.toLevel(static_cast<float>(uv.y()));
       const PatternHost& host = L.host[static_cast<size_t>(B.begin + i)];
@@ -169,8 +227,7 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
         r1 -= w * r;
       }
       if (!linearize) continue;
-      const Mat26& D = global ? Mat26(B.J[static_cast<size_t>(i)] * dLeftAction(B.P.col(i)))
-                              : B.proj[static_cast<size_t>(i)].d_uv_d_T0;
+      const Mat26& D = B.D[static_cast<size_t>(i)];
       Eigen::Matrix2d G;
       G << gxx, gxy, gxy, gyy;
       acc.H.topLeftCorner<6, 6>().noalias() += D.transpose() * G * D;
@@ -193,10 +250,33 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
     for (int j = i + 1; j < 8; ++j) out.H(j, i) = out.H(i, j);
 }
 
+void FrameTracker::projectReference(int level, const SE3d& T_c_w, const Vec6& twist, Eigen::Matrix2Xd* uv,
+                                    std::vector<uint8_t>* valid, std::vector<Eigen::Matrix<double, 2, 6>>* d_uv_d_T,
+                                    Eigen::Matrix3Xd* X_w) const {
+  if (!hasReference()) throw Error("FrameTracker::projectReference: no reference keyframe");
+  LevelPoints& L = *levels_.at(static_cast<size_t>(level));
+  resetRows();
+  uv->resize(2, L.n);
+  if (X_w) X_w->resize(3, L.n);
+  valid->assign(static_cast<size_t>(L.n), 0);
+  if (d_uv_d_T) d_uv_d_T->assign(static_cast<size_t>(L.n), Mat26::Zero());
+  for (Block& B : L.blocks) {
+    projectBlock(B, RsFrame{T_c_w, twist}, d_uv_d_T != nullptr);
+    for (Eigen::Index i = 0; i < B.X_w.cols(); ++i) {
+      const size_t j = static_cast<size_t>(B.begin + i);
+      if (X_w) X_w->col(static_cast<Eigen::Index>(j)) = B.X_w.col(i);
+      uv->col(static_cast<Eigen::Index>(j)) = B.uv.col(i);
+      (*valid)[j] = B.valid[static_cast<size_t>(i)];
+      if (d_uv_d_T && B.valid[static_cast<size_t>(i)]) (*d_uv_d_T)[j] = B.D[static_cast<size_t>(i)];
+    }
+  }
+}
+
 FrameTracker::LevelEnergy FrameTracker::levelEnergy(const ImagePyramid& frame, const TrackingFrame& info, int level,
                                                     const SE3d& T_c_w, const AffineBrightness& affine) const {
   if (!hasReference()) throw Error("FrameTracker::levelEnergy: no reference keyframe");
   Linearization lin;
+  resetRows();
   RsFrame target{T_c_w, info.twist};
   evaluate(frame.level(level), level, target, affine, exposureRatio(ref_.exposure_ms, info.exposure_ms),
            options_.cutoff_th, false, lin);

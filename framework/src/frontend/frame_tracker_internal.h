@@ -17,6 +17,10 @@ constexpr int kBlockPoints = 128;
 using Mat88 = Eigen::Matrix<double, 8, 8>;
 using Vec8 = Eigen::Matrix<double, 8, 1>;
 
+// Rolling-shutter row solve in the tracker: tolerance and iteration cap (rs_projection.h's method).
+constexpr double kRowLinearStepPx = 0.05;  // Newton steps below this are applied linearly (see projectBlock)
+constexpr int kRowMaxIterations = 10;
+
 // Normal equations of (delta(6), a, b) on one level, with energy statistics.
 struct FrameTracker::Linearization {
   Mat88 H = Mat88::Zero();
@@ -49,11 +53,13 @@ struct FrameTracker::Block {
   int begin = 0;                  // index of the first point of the level
   Eigen::Matrix3Xd X_w;           // world points
   // scratch, reused across evaluations (no allocation in steady state)
-  Eigen::Matrix3Xd P;
-  Eigen::Matrix2Xd uv;
-  std::vector<uint8_t> valid;
+  Eigen::Matrix3Xd P0, P;         // points in the target at t = 0, at the row time
+  Eigen::Matrix2Xd uv, uv_a;      // projections (all points / the active ones of a Newton step)
+  std::vector<uint8_t> valid, valid_a;
   std::vector<Jac23> J;
-  std::vector<RsProjection> proj;
+  std::vector<Mat26> D;           // d uv / d T0 (left), row dependence included
+  std::vector<double> row;        // rolling shutter: Newton's row per point (warm start within a guess)
+  std::vector<int> active, still;
   FrameTracker::Linearization lin;
 };
 

@@ -35,6 +35,7 @@ std::string fmt(double v, int prec = 2) {
 FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const TrackingFrame& info,
                                                const SE3d& guess, const std::array<double, 6>& abort_rmse) const {
   Attempt a;
+  resetRows();  // every guess starts its row solves afresh: results do not depend on earlier guesses
   a.T_c_w = guess;
   a.affine = info.affine_guess;
   const double exposure_ratio = exposureRatio(ref_.exposure_ms, info.exposure_ms);

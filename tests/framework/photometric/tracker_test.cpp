@@ -10,6 +10,7 @@
 
 #include "rsvio/frontend/frame_tracker.h"
 #include "rsvio/photometric/pixel_selector.h"
+#include "support/numeric_jacobian.h"
 #include "test_camera.h"
 
 namespace rsvio {
@@ -198,6 +199,47 @@ TEST(FrameTracker, TracksRollingShutterImagesWithTheTwistGiven) {
   gs_tracker.setReference(f.ref);
   const TrackResult g = gs_tracker.track(pyr, info, {guess});
   EXPECT_GT(g.rmse, 1.2 * r.rmse);
+}
+
+TEST(FrameTracker, OwnProjectionMatchesRsProjectionAndNumericJacobian) {
+  // The tracker projects its points itself (global shutter: one batch; rolling shutter: its own row
+  // solve with only d uv / d T0, warm-started rows); it must agree with geometry/rs_projection.h and
+  // with numeric differences of its own uv.
+  const Fixture& f = fixture();
+  const Vec6 xi = twist(1.2, -0.4, 0.6, 0.5, -1.0, 0.4);
+  for (const RowTiming& timing : {RowTiming::rolling(f.K.height * 0.5 - 0.5, 40e-6, true),
+                                  RowTiming::rolling(f.K.height * 0.5 - 0.5, 40e-6, false),
+                                  RowTiming::global(f.K.height * 0.5 - 0.5)}) {
+    SCOPED_TRACE("direction " + std::to_string(timing.direction));
+    FrameTracker tracker(TrackerOptions(), f.camera, timing);
+    tracker.setReference(f.ref);
+    Eigen::Matrix2Xd uv;
+    std::vector<uint8_t> valid;
+    std::vector<Eigen::Matrix<double, 2, 6>> D;
+    Eigen::Matrix3Xd X_w;
+    tracker.projectReference(0, f.T_new, xi, &uv, &valid, &D, &X_w);
+    std::vector<RsProjection> ref;
+    projectRollingShutter(f.camera, timing, RsFrame{f.T_new, xi}, X_w, ref);
+    int checked = 0;
+    for (Eigen::Index i = 0; i < uv.cols(); i += 37) {
+      const size_t s = static_cast<size_t>(i);
+      ASSERT_EQ(static_cast<bool>(valid[s]), ref[s].valid) << "point " << i;
+      if (!valid[s]) continue;
+      EXPECT_LT((uv.col(i) - ref[s].uv).norm(), 1e-4) << "point " << i;
+      EXPECT_TRUE(D[s].isApprox(ref[s].d_uv_d_T0, 1e-3)) << "point " << i;
+      const Eigen::MatrixXd num = test::numericJacobian(
+          [&](const SE3d& T) {
+            Eigen::Matrix2Xd q;
+            std::vector<uint8_t> v;
+            tracker.projectReference(0, T, xi, &q, &v, nullptr);
+            return Vec2(q.col(i));
+          },
+          f.T_new, test::leftPlus<SE3d>, 6, 1e-5);
+      EXPECT_JACOBIAN_NEAR_TOL(D[s], num, 1e-4, 1e-3);
+      ++checked;
+    }
+    EXPECT_GT(checked, 20);
+  }
 }
 
 TEST(FrameTracker, ResultsIdenticalForOneAndTwoThreads) {

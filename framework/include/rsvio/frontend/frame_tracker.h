@@ -5,7 +5,9 @@
 // - State of the new frame: central pose T_c_w^0 (world -> camera at the image timestamp, row y0) and
 //   affine brightness (a, b). Its rolling-shutter twist is NOT estimated here: it is an input (the
 //   prior's or the previous frame's), and every point is projected with the rolling-shutter constraint
-//   solved (geometry/rs_projection.h), so the Jacobian w.r.t. T_c_w^0 includes the row dependence.
+//   solved by Newton on the row as in geometry/rs_projection.h (own loop: only d uv / d T_c_w^0,
+//   rows warm-started within a guess; tested against rs_projection.h), so the Jacobian w.r.t.
+//   T_c_w^0 includes the row dependence.
 //   Poses are perturbed on the LEFT, T <- exp(delta) T (rsvio/lie/lie.h).
 // - Reference: the keyframe's pose, twist, affine brightness, pyramid and points (host pixel, inverse
 //   depth along the camera's unit bearing, i.e. 1 / distance). Every point is fixed in the world at
@@ -153,12 +155,21 @@ class FrameTracker {
   LevelEnergy levelEnergy(const ImagePyramid& frame, const TrackingFrame& info, int level, const SE3d& T_c_w,
                           const AffineBrightness& affine) const;
 
+  // The reference points of one level projected into a frame with central pose T_c_w and twist (the
+  // tracker's own rolling-shutter solve), with d uv / d T_c_w (left perturbation, row dependence
+  // included). Level-0 pixels; X_w (optional) receives the points in the world. For tests and diagnostics.
+  void projectReference(int level, const SE3d& T_c_w, const Vec6& twist, Eigen::Matrix2Xd* uv,
+                        std::vector<uint8_t>* valid, std::vector<Eigen::Matrix<double, 2, 6>>* d_uv_d_T,
+                        Eigen::Matrix3Xd* X_w = nullptr) const;
+
  private:
   struct LevelPoints;
   struct Block;
   struct Linearization;
   struct Attempt;
 
+  void projectBlock(Block& B, const RsFrame& target, bool linearize) const;
+  void resetRows() const;
   void evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
                 double alpha_ratio, double cutoff, bool linearize, Linearization& out) const;
   Attempt trackGuess(const ImagePyramid& frame, const TrackingFrame& info, const SE3d& guess,
