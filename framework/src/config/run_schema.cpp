@@ -1,5 +1,6 @@
 // The schema of `rsvio run` configs. Plugin slots validate their params against the plugin's own table;
 // sections here validate against the tables of the framework subsystems that own them.
+#include "rsvio/backend/backend_options.h"
 #include "rsvio/config/validate.h"
 #include "rsvio/frontend/frontend_options.h"
 
@@ -19,6 +20,8 @@ ConfigSchema runConfigSchema() {
   s.multiSlot("photometric", PluginKind::Photometric, "photometric model terms, keyed by name");
   s.multiSlot("motion", PluginKind::Motion, "motion priors, keyed by name");
   s.section("frontend", frontendParamTable(), "photometric front end: pyramid, point selection, tracking");
+  s.section("backend", backendParamTable(),
+            "photometric back end: window, keyframes, marginalisation, monocular start, divergence tests");
   s.section("output",
             {paramBool("render", true, "render figures and index.html at the end of the run"),
              paramBool("diagnostics", true, "write diagnostics.bin for rsvio diagnose"),

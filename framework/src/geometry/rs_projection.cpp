@@ -27,6 +27,11 @@ Mat36 dLeftAction(const Vec3& p) {
   return J;
 }
 
+// exp(d) and the left Jacobian Jl(d) with the global-shutter case (d = 0: zero twist or row time 0)
+// taken without trigonometry; the results are the same.
+SE3d expOrIdentity(const Vec6& d) { return d.isZero(0.0) ? SE3d() : SE3d::exp(d); }
+Mat6 leftJacobianOrIdentity(const Vec6& d) { return d.isZero(0.0) ? Mat6::Identity().eval() : SE3d::leftJacobian(d); }
+
 // Left-multiplies a 2xK Jacobian by M = (I - a e_v^T)^-1 = [1, a_x / (1 - a_y); 0, 1 / (1 - a_y)].
 template <class Derived>
 void applyImplicitRow(Eigen::MatrixBase<Derived>& A, const Vec2& a) {
@@ -66,7 +71,7 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     Pa.resize(3, static_cast<Eigen::Index>(active.size()));
     for (size_t k = 0; k < active.size(); ++k) {
       const size_t i = active[k];
-      E[i] = SE3d::exp(target.xi * timing.rowTime(v[i]));  // eq. 6 at the row's time (eq. 7)
+      E[i] = expOrIdentity(target.xi * timing.rowTime(v[i]));  // eq. 6 at the row's time (eq. 7)
       P[i] = E[i] * P0[i];
       Pa.col(static_cast<Eigen::Index>(k)) = P[i];
     }
@@ -105,7 +110,10 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     const Eigen::Matrix<double, 2, 3> JR = Jc[i] * E[i].rotationMatrix();
     // Partial derivatives at a fixed row, then M for the row's own dependence on the state.
     r.d_uv_d_T0 = JR * dLeftAction(P0[i]);
-    r.d_uv_d_xi = Jc[i] * dLeftAction(P[i]) * SE3d::leftJacobian(target.xi * t) * t;
+    if (t != 0.0)
+      r.d_uv_d_xi = Jc[i] * dLeftAction(P[i]) * leftJacobianOrIdentity(target.xi * t) * t;
+    else
+      r.d_uv_d_xi.setZero();
     r.d_uv_d_X = JR * target.T_c_w0.rotationMatrix();
     // The row of the solution is uv.y (equal to the iterate within tolerance; for a global shutter the
     // iterate stays at y0 while the pixel's row is uv.y).
@@ -147,7 +155,7 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
     const double rho = idepth[i];
     if (!(rho > 0.0) || !std::isfinite(rho)) continue;
     const size_t s = static_cast<size_t>(i);
-    Eh_inv[s] = SE3d::exp(-host.xi * timing.rowTime(v_h[i]));
+    Eh_inv[s] = expOrIdentity(-host.xi * timing.rowTime(v_h[i]));
     Z[s] = Eh_inv[s] * Vec3(bearing_h.col(i) / rho);
     X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * Z[s];
     idx.push_back(i);
@@ -168,7 +176,10 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
     // Host pose T_h_w0 <- exp(d) T_h_w0:  X = T_h_w0^-1 exp(-d) Z.
     r.d_uv_d_Th0 = -d_uv_d_Z * dLeftAction(Z[s]);
     // Host twist: Z = exp(-xi_h t_h) Y,  d Z / d xi_h = [I, -[Z]x] Jl(-xi_h t_h) (-t_h).
-    r.d_uv_d_xi_h = d_uv_d_Z * dLeftAction(Z[s]) * SE3d::leftJacobian(-host.xi * t_h) * (-t_h);
+    if (t_h != 0.0)
+      r.d_uv_d_xi_h = d_uv_d_Z * dLeftAction(Z[s]) * leftJacobianOrIdentity(-host.xi * t_h) * (-t_h);
+    else
+      r.d_uv_d_xi_h.setZero();
     r.d_uv_d_idepth = d_uv_d_Z * (Eh_inv[s].rotationMatrix() * Vec3(-bearing_h.col(i) / (rho * rho)));
     // Host row time: d Z / d t_h = -(xi_v + xi_w x Z).
     r.d_uv_d_line_delay += d_uv_d_Z * Vec3(-(xh_v + xh_w.cross(Z[s]))) * timing.dRowTimeDLineDelay(v_h[i]);

@@ -1,0 +1,69 @@
+// Options of the photometric back end (windowed bundle adjustment, keyframes, points, marginalisation,
+// monocular initialisation, divergence detection): the "backend" section of a run config.
+//
+// Defaults follow DSO (Engel et al. 2018; its settings.cpp values are named where they differ in
+// meaning): 7 keyframes, ~2000 active points, 6 LM iterations per keyframe, marginalisation when fewer
+// than 5 % of a keyframe's points remain or its brightness drifted by more than exp(0.7), otherwise
+// the keyframe with the largest distance score. backendParamTable() is the one table that validation,
+// `rsvio plugins`-style listings and docs/backend.md use.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "rsvio/plugin/plugin.h"
+
+namespace rsvio {
+
+struct BackendOptions {
+  // Window and points.
+  int max_keyframes = 7;              // DSO setting_maxFrames
+  int min_keyframes = 5;              // DSO setting_minFrames: never marginalise below this by the point test
+  int active_points = 2000;           // target number of active points in the window (DSO desiredPointDensity)
+  // Optimisation.
+  int max_iterations = 6;             // LM iterations per new keyframe (DSO setting_maxOptIterations)
+  double lambda_initial = 1e-4;       // relative diagonal damping, H_ii *= (1 + lambda)
+  double step_threshold = 1e-4;       // stop when the relative energy decrease is below this
+  double marg_weight_factor = 0.25;   // Hessian factor of marginalised points (DSO setting_margWeightFac)
+  double min_idepth_hessian_marg = 50.0;  // a point leaving the window goes into the prior above this (DSO)
+  int min_good_residuals = 3;         // observations a point needs to be kept / marginalised (DSO: 3)
+  double gauge_information = 1e12;   // information fixing the first keyframe's pose and affine a, b
+  double twist_regularization = 1e-6; // tiny information on twists without a prior (rolling shutter)
+  // Keyframe selection (DSO's weights; the flows are RMS pixel shifts normalised by width + height).
+  double kf_weight_t = 0.04 * (640 + 480);   // translation-only flow
+  double kf_weight_rt = 0.02 * (640 + 480);  // full flow
+  double kf_weight_affine = 2.0;             // |log exposure ratio|
+  double kf_rmse_factor = 2.0;               // new KF when rmse > factor x the first rmse after the last KF
+  double kf_max_interval_s = 0.0;            // new KF at least this often (0 = off, DSO's default)
+  // Marginalisation of keyframes.
+  double min_points_remaining = 0.05;  // DSO setting_minPointsRemaining
+  double max_log_affine = 0.7;         // DSO setting_maxLogAffFacInWindow
+  // Candidate activation (which candidates are ready: the front end's trace_* options).
+  int activation_iterations = 3;            // GN iterations on a candidate's inverse depth (DSO: 3)
+  double activation_min_dist_px = 2.0;      // initial distance between active points, level-1 px (DSO: 2)
+  // Monocular initialisation (runs without an IMU).
+  int init_min_frames = 3;            // frames after the first before an attempt
+  int init_max_frames = 60;           // give up (status failed) after this many frames
+  double init_min_flow_px = 0.025;    // median corner flow, fraction of the image diagonal
+  double init_min_parallax_deg = 1.0; // median triangulation angle of the inlier corners
+  double init_min_inlier_ratio = 0.6; // essential-matrix RANSAC inliers
+  int init_corners = 400;             // corners tracked with pyramidal Lucas-Kanade
+  // Divergence detection (the run ends "failed" with the reason).
+  int max_lost_frames = 3;            // consecutive frames the tracker loses
+  double fail_max_rmse = 40.0;        // BA RMSE per pattern pixel, intensity units
+  double fail_min_inlier_ratio = 0.3; // BA inlier observations / all
+  int fail_min_points = 20;           // active points after a keyframe's BA
+  double fail_max_scale_change = 50.0;  // median inverse depth vs. the initial one, either way
+
+  void validate() const;  // cross-field checks; throws ConfigError naming the keys
+  static BackendOptions fromParams(const Params& p);
+};
+
+// The "backend" section's table (keys as the fields above).
+ParamTable backendParamTable();
+
+// Reads the "backend" section of an effective config with defaults filled in; problems (wrong type,
+// unknown key) throw ConfigError listing each with its JSON path.
+BackendOptions backendOptionsFromConfig(const nlohmann::json& effective_config);
+
+}  // namespace rsvio

@@ -1,0 +1,123 @@
+// The optimisation window of the photometric back end: keyframes, their active points and the points'
+// observations (paper sec. IV-A, eq. 8: E_ph = sum over keyframes i, points p hosted in i, targets j).
+//
+// Contract
+// - A keyframe's state (paper eq. 6): central pose T_c_w^0 (world W_f -> camera at the image timestamp,
+//   raw row y0), affine brightness (a, b) and, when the shutter is rolling, the twist xi per second
+//   (translation; rotation), T_c_w(t) = exp(xi t) T_c_w^0. Poses are perturbed on the LEFT,
+//   T <- exp(delta) T (rsvio/lie/lie.h); a, b and the twist additively.
+// - Normal-equation block of a keyframe (StateLayout): pose [0, 6), affine (a, b) [6, 8), twist [8, 14)
+//   when rolling. Blocks are ordered as the window (oldest first). IMU velocity/bias blocks and a global
+//   scale-gravity block will follow the same pattern (appended after the twist / after all keyframes).
+// - A point is hosted by a keyframe at an integer level-0 pixel (u, v) of its RAW image, with the unit
+//   bearing of that pixel and its inverse depth rho = 1 / distance along the bearing; it is fixed in
+//   the world at the host row's capture time (rs_projection.h, "host-frame points").
+// - A point has at most one observation per target keyframe (never in its host).
+// - Keyframes are owned by the window (unique_ptr), so Keyframe* stays valid until the keyframe leaves;
+//   `index` is the keyframe's current position in the window and changes when older ones leave.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "rsvio/frontend/candidate_points.h"
+#include "rsvio/interfaces/motion_prior.h"
+#include "rsvio/lie/se3.h"
+#include "rsvio/photometric/image_pyramid.h"
+#include "rsvio/photometric/photometric_residual.h"
+
+namespace rsvio {
+
+struct KeyframeState {
+  SE3d T_c_w;                 // central pose, camera from world (W_f)
+  AffineBrightness affine;
+  Vec6 twist = Vec6::Zero();  // per second; optimised only with a rolling shutter
+};
+
+// Layout of one keyframe's block of the normal equations.
+struct StateLayout {
+  static constexpr int kPose = 0;
+  static constexpr int kAffine = 6;
+  static constexpr int kTwist = 8;
+  bool rolling = false;
+  int kfDim() const { return rolling ? 14 : 8; }
+};
+
+// kIn: used; kOob: the projection left the image or failed; kOutlier: energy above the outlier energy.
+enum class ObsState : uint8_t { kIn, kOob, kOutlier };
+
+struct Keyframe;
+
+struct ActiveObservation {
+  Keyframe* target = nullptr;
+  ObsState state = ObsState::kIn;
+  float energy = 0.f;           // at the last evaluation
+  // The last evaluation, kept for the diagnostics log (io/diagnostics_log.h).
+  float u = 0.f, v = 0.f;       // projected centre in the target, raw level-0 pixels
+  float grad_u = 0.f, grad_v = 0.f;
+  float mean_residual = 0.f;
+  float mean_weight = 0.f;
+};
+
+struct ActivePoint {
+  Keyframe* host = nullptr;
+  int64_t id = 0;               // unique over the run (deterministic order of creation)
+  float u = 0.f, v = 0.f;       // host pixel, level 0 (integers for selected points)
+  Vec3 bearing = Vec3::UnitZ(); // unit bearing of (u, v) in the host camera
+  Eigen::Matrix<double, 3, 2> d_bearing_d_uv = Eigen::Matrix<double, 3, 2>::Zero();
+  double idepth = 1.0;          // 1 / distance along the bearing
+  double idepth_hessian = 0.0;  // information of rho at the last linearisation (no damping)
+  PatternHost pattern;          // host intensities and gradient weights of the 8-pixel pattern
+  std::vector<ActiveObservation> obs;
+
+  int numIn() const {
+    int n = 0;
+    for (const ActiveObservation& o : obs) n += o.state == ObsState::kIn;
+    return n;
+  }
+};
+
+struct Keyframe {
+  int64_t frame_index = 0;      // position in the input sequence
+  int64_t t_ns = 0;             // image timestamp (row y0)
+  int64_t kf_id = 0;            // counts keyframes over the run
+  int index = -1;               // position in the window
+  double exposure_ms = std::numeric_limits<double>::quiet_NaN();
+  std::shared_ptr<const ImagePyramid> pyramid;
+
+  KeyframeState state;
+  KeyframeState backup;         // LM: state before the trial step
+  KeyframeState lin;            // linearisation point, frozen once the keyframe is in the prior (FEJ)
+  bool in_prior = false;        // the marginalisation prior has a block for this keyframe
+  bool gauge = false;           // pose and affine fixed (the first keyframe: fixes the gauge)
+
+  bool has_twist_prior = false; // paper eq. 33 or a smooth-motion prior (motion_prior.h)
+  TwistPrior twist_prior;
+  Vec6 twist_start = Vec6::Zero();  // where twist_regularization pulls when there is no prior
+
+  std::vector<ActivePoint> points;         // active points hosted here
+  std::vector<CandidatePoint> candidates;  // waiting for activation (frontend/candidate_points.h)
+  int points_out = 0;                      // points that left (dropped or marginalised): DSO's "out"
+  bool flagged_for_marg = false;
+  // Twist seen from the neighbouring frames' poses (d T / dt, per second), for the diagnostics log of
+  // a global-shutter run; set once the next frame is tracked.
+  bool has_observed_twist = false;
+  Vec6 observed_twist = Vec6::Zero();
+};
+
+using KeyframeList = std::vector<std::unique_ptr<Keyframe>>;
+
+// Renumbers Keyframe::index after the window changed.
+inline void reindex(KeyframeList& window) {
+  for (size_t i = 0; i < window.size(); ++i) window[i]->index = static_cast<int>(i);
+}
+
+// Perturbation of a keyframe's state from its linearisation point, in the block layout:
+// pose log(T T_lin^-1) (left), affine a - a_lin, b - b_lin, twist xi - xi_lin.
+Eigen::VectorXd stateDelta(const KeyframeState& x, const KeyframeState& lin, const StateLayout& layout);
+
+// Applies a block step (layout order) to a state: T <- exp(d) T, a += d, b += d, xi += d.
+void applyStep(KeyframeState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout);
+
+}  // namespace rsvio

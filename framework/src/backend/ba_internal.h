@@ -1,0 +1,96 @@
+// Private state of BundleAdjuster shared by ba_linearize.cpp and ba_solve.cpp.
+#pragma once
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "rsvio/backend/bundle_adjustment.h"
+#include "rsvio/frontend/block_runner.h"
+
+namespace rsvio {
+namespace ba {
+
+// Point chunks of the deterministic sums: a fixed count, so results do not depend on the threads.
+constexpr int kPointChunks = 16;
+
+using Mat66 = Eigen::Matrix<double, 6, 6>;
+using Vec6d = Eigen::Matrix<double, 6, 1>;
+// d uv / d (host pose 6, host twist 6, target pose 6, target twist 6, idepth 1).
+using GeoJac = Eigen::Matrix<double, 2, 25>;
+constexpr int kColHostPose = 0, kColHostTwist = 6, kColTargetPose = 12, kColTargetTwist = 18, kColIdepth = 24;
+
+// One observation at one linearisation. The pattern's normal equations are kept factored in the six
+// "virtual residual coordinates" (u, v, a_h, b_h, a_t, b_t): with the 8x6 matrix K = [G | A] (G the
+// pattern gradients, A the affine Jacobians), M = K^T W K and g = K^T W r; the state Jacobian of those
+// coordinates is GeoJac for (u, v) and selectors for the affine ones (DSO's factorisation, 2x2 + 2x4
+// + 4x4 instead of 8 rows).
+struct ObsLin {
+  ObsState state = ObsState::kOob;
+  float energy = 0.f;
+  GeoJac Jg;
+  Mat66 M;
+  Vec6d g;
+  float u = 0.f, v = 0.f, grad_u = 0.f, grad_v = 0.f, mean_r = 0.f, mean_w = 0.f;
+};
+
+// All observations of one host into one target: evaluated with one batch projection.
+struct PairWork {
+  Keyframe* host = nullptr;
+  Keyframe* target = nullptr;
+  std::vector<int> obs;  // indices into Impl::obs_refs
+  // scratch, reused
+  Eigen::Matrix3Xd bearing;
+  Eigen::VectorXd v_h, idepth;
+  std::vector<RsHostProjection> proj;
+};
+
+struct ObsRef {
+  int point = 0;  // index into Impl::points
+  int obs = 0;    // index into the point's obs
+};
+
+struct Linearization {
+  std::vector<ObsLin> obs;              // per ObsRef
+  std::vector<double> Hpp, bp;          // per point (undamped)
+  std::vector<int> blk_begin, blk_count;  // per point: involved blocks in the arena
+  std::vector<int> blk_ids;             // window indices (host first)
+  std::vector<double> hpc;              // kfDim values per arena entry: d^2 E / d rho d x_block
+  Eigen::MatrixXd Hcc;                  // cameras: photometric + priors + terms, undamped, unmasked
+  Eigen::VectorXd bc;
+  double energy_photo = 0.0;            // all observations (kOob/kOutlier at the outlier energy)
+  double energy_photo_in = 0.0;         // kIn observations only
+  double energy_other = 0.0;            // priors and terms
+  int num_in = 0, num_oob = 0, num_outlier = 0;
+  double total() const { return energy_photo + energy_other; }
+};
+
+struct ChunkSums {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  double energy = 0.0, energy_in = 0.0;
+  int num_in = 0, num_oob = 0, num_outlier = 0;
+};
+
+}  // namespace ba
+
+struct BundleAdjuster::Impl {
+  using PairWork = ba::PairWork;
+  using ObsRef = ba::ObsRef;
+  using Linearization = ba::Linearization;
+  using ChunkSums = ba::ChunkSums;
+  std::unique_ptr<BlockRunner> runner;
+  // Structure (rebuilt by buildStructure when the window changed).
+  KeyframeList* window = nullptr;
+  std::vector<ActivePoint*> points;
+  std::vector<ObsRef> obs_refs;
+  std::vector<int> point_obs_begin;     // per point, into obs_refs (its obs are contiguous)
+  std::vector<PairWork> pairs;
+  std::vector<uint8_t> fixed;           // per camera dimension
+  int nc = 0;                           // camera dimensions
+  // Linearisations: current (accepted) and trial.
+  Linearization cur, trial;
+  std::vector<ChunkSums> chunks;
+  const MarginalizationPrior* prior = nullptr;
+};
+
+}  // namespace rsvio

@@ -1,0 +1,301 @@
+// Bundle adjustment, linearisation: structure of the window, residuals per host-target pair, per-point
+// accumulation with the point's Schur data, keyframe priors (contract in rsvio/backend/bundle_adjustment.h).
+#include <algorithm>
+#include <cmath>
+
+#include "ba_internal.h"
+#include "rsvio/interfaces/camera.h"
+
+namespace rsvio {
+namespace ba {
+
+void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleAdjustmentConfig& cfg,
+                    const std::vector<ActivePoint*>* only) {
+  reindex(window);
+  m.window = &window;
+  const int nk = static_cast<int>(window.size());
+  const int kd = cfg.layout.kfDim();
+  m.nc = nk * kd;
+  if (only) {
+    std::vector<ActivePoint*> copy = *only;  // `only` may be m.points itself (BundleAdjuster::points())
+    m.points.swap(copy);
+  } else {
+    m.points.clear();
+    for (auto& kf : window)
+      for (ActivePoint& p : kf->points) m.points.push_back(&p);
+  }
+  m.obs_refs.clear();
+  m.point_obs_begin.assign(m.points.size() + 1, 0);
+  for (auto& pw : m.pairs) pw.obs.clear();
+  m.pairs.resize(static_cast<size_t>(nk) * nk);
+  for (int h = 0; h < nk; ++h)
+    for (int t = 0; t < nk; ++t) {
+      m.pairs[static_cast<size_t>(h) * nk + t].host = window[h].get();
+      m.pairs[static_cast<size_t>(h) * nk + t].target = window[t].get();
+    }
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    ActivePoint& p = *m.points[i];
+    m.point_obs_begin[i] = static_cast<int>(m.obs_refs.size());
+    for (size_t j = 0; j < p.obs.size(); ++j) {
+      const int ref = static_cast<int>(m.obs_refs.size());
+      m.obs_refs.push_back({static_cast<int>(i), static_cast<int>(j)});
+      m.pairs[static_cast<size_t>(p.host->index) * nk + p.obs[j].target->index].obs.push_back(ref);
+    }
+  }
+  m.point_obs_begin[m.points.size()] = static_cast<int>(m.obs_refs.size());
+  m.fixed.assign(static_cast<size_t>(m.nc), 0);
+  for (int k = 0; k < nk; ++k) {
+    uint8_t* f = m.fixed.data() + static_cast<size_t>(k) * kd;
+    if (window[k]->gauge)
+      for (int i = 0; i < 8; ++i) f[i] = 1;
+    if (!cfg.estimate_affine) f[StateLayout::kAffine] = f[StateLayout::kAffine + 1] = 1;
+  }
+  // Arena of per-point blocks: host + one per observation at most.
+  for (Linearization* L : {&m.cur, &m.trial}) {
+    L->obs.resize(m.obs_refs.size());
+    L->Hpp.assign(m.points.size(), 0.0);
+    L->bp.assign(m.points.size(), 0.0);
+    L->blk_begin.resize(m.points.size());
+    L->blk_count.assign(m.points.size(), 0);
+    int total = 0;
+    for (size_t i = 0; i < m.points.size(); ++i) {
+      L->blk_begin[i] = total;
+      total += 1 + (m.point_obs_begin[i + 1] - m.point_obs_begin[i]);
+    }
+    L->blk_ids.resize(static_cast<size_t>(total));
+    L->hpc.resize(static_cast<size_t>(total) * kd);
+  }
+  m.chunks.resize(kPointChunks);
+  for (ChunkSums& c : m.chunks) {
+    c.H.resize(m.nc, m.nc);
+    c.b.resize(m.nc);
+  }
+}
+
+namespace {
+
+// Evaluates every observation of one host-target pair.
+void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const BundleAdjustmentConfig& cfg,
+                  const CameraModel& camera, const RowTiming& timing, const ResidualKernel& kernel) {
+  const int n = static_cast<int>(pw.obs.size());
+  if (n == 0) return;
+  pw.bearing.resize(3, n);
+  pw.v_h.resize(n);
+  pw.idepth.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const ObsRef& ref = m.obs_refs[static_cast<size_t>(pw.obs[static_cast<size_t>(k)])];
+    const ActivePoint& p = *m.points[static_cast<size_t>(ref.point)];
+    pw.bearing.col(k) = p.bearing;
+    pw.v_h[k] = p.v;
+    pw.idepth[k] = p.idepth;
+  }
+  const bool rolling = cfg.layout.rolling;
+  RsFrame host{pw.host->state.T_c_w, rolling ? pw.host->state.twist : Vec6::Zero()};
+  RsFrame target{pw.target->state.T_c_w, rolling ? pw.target->state.twist : Vec6::Zero()};
+  projectRollingShutter(camera, timing, host, target, pw.bearing, pw.v_h, pw.idepth, pw.proj);
+
+  const ImageLevel& img = pw.target->pyramid->level(0);
+  const double exposure_ratio = (pw.host->exposure_ms > 0.0 && pw.target->exposure_ms > 0.0)
+                                    ? pw.target->exposure_ms / pw.host->exposure_ms
+                                    : 1.0;
+  const AffineTransfer tr = affineTransfer(pw.host->state.affine, pw.target->state.affine, exposure_ratio);
+  const float alpha = static_cast<float>(tr.alpha), beta = static_cast<float>(tr.beta);
+  const Eigen::Matrix3d R_w_h0 = pw.host->state.T_c_w.so3().inverse().matrix();
+  const Vec3 omega_h = host.xi.tail<3>();
+  const float e_out = kernel.outlier_energy;
+
+  PatternResidual res;
+  for (int k = 0; k < n; ++k) {
+    const ObsRef& ref = m.obs_refs[static_cast<size_t>(pw.obs[static_cast<size_t>(k)])];
+    const ActivePoint& p = *m.points[static_cast<size_t>(ref.point)];
+    ObsLin& ol = L.obs[static_cast<size_t>(pw.obs[static_cast<size_t>(k)])];
+    const RsHostProjection& pr = pw.proj[static_cast<size_t>(k)];
+    ol.state = ObsState::kOob;
+    ol.energy = e_out;
+    if (!pr.valid) continue;
+    // Local warp W = d p' / d p (host pixel -> target pixel at fixed inverse depth).
+    Eigen::Matrix3d R_w_hp = R_w_h0;
+    if (rolling) R_w_hp = R_w_h0 * SO3d::exp(-omega_h * timing.rowTime(p.v)).matrix();
+    const Eigen::Matrix2d Wm = pr.d_uv_d_X * R_w_hp * p.d_bearing_d_uv * (1.0 / p.idepth);
+    const float warp[4] = {static_cast<float>(Wm(0, 0)), static_cast<float>(Wm(0, 1)), static_cast<float>(Wm(1, 0)),
+                           static_cast<float>(Wm(1, 1))};
+    const float u = static_cast<float>(pr.uv.x()), v = static_cast<float>(pr.uv.y());
+    ol.u = u;
+    ol.v = v;
+    if (!std::isfinite(u) || !std::isfinite(v) || !img.inside(u, v, 1.f)) continue;
+    if (!evaluatePattern(img, u, v, warp, 1.f, p.pattern, alpha, beta, kernel, res)) continue;
+    ol.grad_u = res.gx[kPatternCentre];
+    ol.grad_v = res.gy[kPatternCentre];
+    float sr = 0.f, sw = 0.f;
+    for (int i = 0; i < kPatternSize; ++i) {
+      sr += res.r[i];
+      sw += res.w[i];
+    }
+    ol.mean_r = sr / kPatternSize;
+    ol.mean_w = sw / kPatternSize;
+    if (res.outlier) {
+      ol.state = ObsState::kOutlier;
+      continue;
+    }
+    ol.state = ObsState::kIn;
+    ol.energy = res.energy;
+    // M = K^T W K, g = K^T W r with K rows (gx, gy, c, alpha, -c, -1), c = alpha (I_host - b_host).
+    ol.M.setZero();
+    ol.g.setZero();
+    const double hb = pw.host->state.affine.b;
+    for (int i = 0; i < kPatternSize; ++i) {
+      const double c = tr.alpha * (p.pattern.color[i] - hb);
+      Vec6d kr;
+      kr << res.gx[i], res.gy[i], c, tr.alpha, -c, -1.0;
+      const double w = res.w[i];
+      ol.M.noalias() += (w * kr).lazyProduct(kr.transpose());  // 6x6: coefficient-wise, no GEMM set-up
+      ol.g += (w * res.r[i]) * kr;
+    }
+    ol.Jg.block<2, 6>(0, kColHostPose) = pr.d_uv_d_Th0;
+    ol.Jg.block<2, 6>(0, kColHostTwist) = pr.d_uv_d_xi_h;
+    ol.Jg.block<2, 6>(0, kColTargetPose) = pr.d_uv_d_T0;
+    ol.Jg.block<2, 6>(0, kColTargetTwist) = pr.d_uv_d_xi;
+    ol.Jg.col(kColIdepth) = pr.d_uv_d_idepth;
+  }
+}
+
+// Accumulates the points of one chunk: their Schur data and the camera blocks.
+template <int KD>
+void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
+  constexpr int N = 2 * KD + 1;
+  using JL = Eigen::Matrix<double, 6, N>;
+  using HL = Eigen::Matrix<double, N, N>;
+  ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
+  cs.H.setZero();
+  cs.b.setZero();
+  cs.energy = cs.energy_in = 0.0;
+  cs.num_in = cs.num_oob = cs.num_outlier = 0;
+  const int np = static_cast<int>(m.points.size());
+  const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
+  const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+  JL Jl = JL::Zero();
+  Jl(2, StateLayout::kAffine) = 1.0;
+  Jl(3, StateLayout::kAffine + 1) = 1.0;
+  Jl(4, KD + StateLayout::kAffine) = 1.0;
+  Jl(5, KD + StateLayout::kAffine + 1) = 1.0;
+  Eigen::Matrix<double, 6, N> MJ;
+  HL Hl;
+  Eigen::Matrix<double, N, 1> bl;
+  for (int i = begin; i < end; ++i) {
+    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
+    const int hb = p.host->index;
+    double Hpp = 0.0, bp = 0.0;
+    const int ab = L.blk_begin[static_cast<size_t>(i)];
+    int nb = 1;
+    L.blk_ids[static_cast<size_t>(ab)] = hb;
+    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_host(L.hpc.data() + static_cast<size_t>(ab) * KD);
+    h_host.setZero();
+    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
+      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
+      cs.energy += ol.energy;
+      if (ol.state == ObsState::kOob) ++cs.num_oob;
+      if (ol.state == ObsState::kOutlier) ++cs.num_outlier;
+      if (ol.state != ObsState::kIn) continue;
+      ++cs.num_in;
+      cs.energy_in += ol.energy;
+      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
+      Jl.template block<2, 6>(0, StateLayout::kPose) = ol.Jg.block<2, 6>(0, kColHostPose);
+      Jl.template block<2, 6>(0, KD + StateLayout::kPose) = ol.Jg.block<2, 6>(0, kColTargetPose);
+      if constexpr (KD == 14) {
+        Jl.template block<2, 6>(0, StateLayout::kTwist) = ol.Jg.block<2, 6>(0, kColHostTwist);
+        Jl.template block<2, 6>(0, KD + StateLayout::kTwist) = ol.Jg.block<2, 6>(0, kColTargetTwist);
+      }
+      Jl.template block<2, 1>(0, 2 * KD) = ol.Jg.col(kColIdepth);
+      // Small fixed sizes: lazyProduct keeps Eigen from its GEMM path (packing costs more than the work).
+      MJ.noalias() = ol.M.lazyProduct(Jl);
+      Hl.noalias() = Jl.transpose().lazyProduct(MJ);
+      bl.noalias() = -Jl.transpose() * ol.g;
+      Hpp += Hl(2 * KD, 2 * KD);
+      bp += bl[2 * KD];
+      h_host += Hl.template block<KD, 1>(0, 2 * KD);
+      L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
+      Eigen::Map<Eigen::Matrix<double, KD, 1>>(L.hpc.data() + static_cast<size_t>(ab + nb) * KD) =
+          Hl.template block<KD, 1>(KD, 2 * KD);
+      ++nb;
+      cs.H.template block<KD, KD>(hb * KD, hb * KD) += Hl.template block<KD, KD>(0, 0);
+      cs.H.template block<KD, KD>(hb * KD, tb * KD) += Hl.template block<KD, KD>(0, KD);
+      cs.H.template block<KD, KD>(tb * KD, hb * KD) += Hl.template block<KD, KD>(KD, 0);
+      cs.H.template block<KD, KD>(tb * KD, tb * KD) += Hl.template block<KD, KD>(KD, KD);
+      cs.b.template segment<KD>(hb * KD) += bl.template head<KD>();
+      cs.b.template segment<KD>(tb * KD) += bl.template segment<KD>(KD);
+    }
+    L.Hpp[static_cast<size_t>(i)] = Hpp;
+    L.bp[static_cast<size_t>(i)] = bp;
+    L.blk_count[static_cast<size_t>(i)] = nb;
+  }
+}
+
+}  // namespace
+
+void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                          const CameraModel& camera, const RowTiming& timing) {
+  const ResidualKernel kernel(cfg.residual);
+  m.runner->run(static_cast<int>(m.pairs.size()),
+                [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, timing, kernel); });
+  if (cfg.layout.rolling) {
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14>(m, L, c); });
+  } else {
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<8>(m, L, c); });
+  }
+  L.Hcc.setZero(m.nc, m.nc);
+  L.bc.setZero(m.nc);
+  L.energy_photo = L.energy_photo_in = 0.0;
+  L.num_in = L.num_oob = L.num_outlier = 0;
+  for (const ChunkSums& c : m.chunks) {  // fixed order: deterministic
+    L.Hcc += c.H;
+    L.bc += c.b;
+    L.energy_photo += c.energy;
+    L.energy_photo_in += c.energy_in;
+    L.num_in += c.num_in;
+    L.num_oob += c.num_oob;
+    L.num_outlier += c.num_outlier;
+  }
+}
+
+double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
+                      Eigen::Ref<Eigen::VectorXd> b) {
+  double e = 0.0;
+  const int ia = StateLayout::kAffine;
+  if (cfg.estimate_affine && !kf.gauge) {
+    const double a = kf.state.affine.a, bb = kf.state.affine.b;
+    H(ia, ia) += cfg.affine_prior_a;
+    b[ia] -= cfg.affine_prior_a * a;
+    H(ia + 1, ia + 1) += cfg.affine_prior_b;
+    b[ia + 1] -= cfg.affine_prior_b * bb;
+    e += cfg.affine_prior_a * a * a + cfg.affine_prior_b * bb * bb;
+  }
+  if (cfg.layout.rolling) {
+    const int it = StateLayout::kTwist;
+    if (kf.has_twist_prior) {
+      const Vec6 r = kf.state.twist - kf.twist_prior.mean;
+      H.block<6, 6>(it, it) += kf.twist_prior.information;
+      b.segment<6>(it) -= kf.twist_prior.information * r;
+      e += r.dot(kf.twist_prior.information * r);
+    } else {
+      const Vec6 r = kf.state.twist - kf.twist_start;
+      H.block<6, 6>(it, it).diagonal().array() += cfg.twist_regularization;
+      b.segment<6>(it) -= cfg.twist_regularization * r;
+      e += cfg.twist_regularization * r.squaredNorm();
+    }
+  }
+  return e;
+}
+
+void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                    const std::vector<const WindowTerm*>& terms) {
+  const int kd = cfg.layout.kfDim();
+  double e = 0.0;
+  for (auto& kf : *m.window)
+    e += keyframePriors(*kf, cfg, L.Hcc.block(kf->index * kd, kf->index * kd, kd, kd), L.bc.segment(kf->index * kd, kd));
+  if (m.prior) e += m.prior->addTo(L.Hcc, L.bc);
+  for (const WindowTerm* t : terms) e += t->linearize(*m.window, cfg.layout, L.Hcc, L.bc);
+  L.energy_other = e;
+}
+
+}  // namespace ba
+}  // namespace rsvio

@@ -1,0 +1,415 @@
+// Bundle adjustment, solving: damping, Schur complement of the inverse depths or the full sparse system,
+// back-substitution and the Levenberg-Marquardt loop (contract in rsvio/backend/bundle_adjustment.h).
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "ba_internal.h"
+#include "rsvio/interfaces/solver.h"
+
+namespace rsvio {
+namespace ba {
+void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleAdjustmentConfig& cfg,
+                    const std::vector<ActivePoint*>* only);
+void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                          const CameraModel& camera, const RowTiming& timing);
+void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                    const std::vector<const WindowTerm*>& terms);
+double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
+                      Eigen::Ref<Eigen::VectorXd> b);
+
+namespace {
+
+constexpr double kMinHpp = 1e-8;      // a point with less inverse-depth information is not moved
+constexpr double kMinDiag = 1e-12;    // a camera dimension with less information is held fixed
+
+// Damped, masked camera block: H_ii (1 + lambda); fixed or unobserved dimensions get a unit row.
+void dampAndMask(const BundleAdjuster::Impl& m, const Linearization& L, double lambda, Eigen::MatrixXd& H,
+                 Eigen::VectorXd& b, std::vector<double>& keep) {
+  H = L.Hcc;
+  b = L.bc;
+  keep.assign(static_cast<size_t>(m.nc), 1.0);
+  for (int i = 0; i < m.nc; ++i) {
+    if (m.fixed[static_cast<size_t>(i)] || !(H(i, i) > kMinDiag)) keep[static_cast<size_t>(i)] = 0.0;
+  }
+  for (int i = 0; i < m.nc; ++i) {
+    if (keep[static_cast<size_t>(i)] == 0.0) {
+      H.row(i).setZero();
+      H.col(i).setZero();
+      H(i, i) = 1.0;
+      b[i] = 0.0;
+    } else {
+      H(i, i) *= 1.0 + lambda;
+    }
+  }
+}
+
+template <int KD>
+void schurChunk(BundleAdjuster::Impl& m, const Linearization& L, double lambda, const std::vector<double>& keep,
+                int chunk) {
+  ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
+  cs.H.setZero();
+  cs.b.setZero();
+  const int np = static_cast<int>(m.points.size());
+  const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
+  const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+  using V = Eigen::Matrix<double, KD, 1>;
+  V hm[64];
+  for (int i = begin; i < end; ++i) {
+    const double Hpp = L.Hpp[static_cast<size_t>(i)] * (1.0 + lambda);
+    if (!(Hpp > kMinHpp)) continue;
+    const double inv = 1.0 / Hpp;
+    const int ab = L.blk_begin[static_cast<size_t>(i)];
+    const int nb = std::min(L.blk_count[static_cast<size_t>(i)], 64);
+    for (int a = 0; a < nb; ++a) {
+      const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
+      hm[a] = Eigen::Map<const V>(L.hpc.data() + static_cast<size_t>(ab + a) * KD)
+                  .cwiseProduct(Eigen::Map<const V>(keep.data() + static_cast<size_t>(ia) * KD));
+    }
+    const double bp = L.bp[static_cast<size_t>(i)];
+    for (int a = 0; a < nb; ++a) {
+      const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
+      cs.b.template segment<KD>(ia * KD) += hm[a] * (bp * inv);
+      for (int c = 0; c < nb; ++c) {
+        const int ic = L.blk_ids[static_cast<size_t>(ab + c)];
+        cs.H.template block<KD, KD>(ia * KD, ic * KD).noalias() += (hm[a] * inv) * hm[c].transpose();
+      }
+    }
+  }
+}
+
+// dx_p from dx_c: rho step = (b_p - h^T dx_c) / H_pp.
+void backSubstitute(const BundleAdjuster::Impl& m, const Linearization& L, double lambda, int kd,
+                    const std::vector<double>& keep, const Eigen::VectorXd& dx_c, Eigen::VectorXd& dx_p) {
+  dx_p.setZero(static_cast<Eigen::Index>(m.points.size()));
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    const double Hpp = L.Hpp[i] * (1.0 + lambda);
+    if (!(Hpp > kMinHpp)) continue;
+    double r = L.bp[i];
+    const int ab = L.blk_begin[i];
+    for (int a = 0; a < L.blk_count[i]; ++a) {
+      const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
+      for (int k = 0; k < kd; ++k)
+        r -= L.hpc[static_cast<size_t>(ab + a) * kd + k] * keep[static_cast<size_t>(ia * kd + k)] * dx_c[ia * kd + k];
+    }
+    dx_p[static_cast<Eigen::Index>(i)] = r / Hpp;
+  }
+}
+
+bool solveSchur(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdjustmentConfig& cfg,
+                SolverBackend& solver, double lambda, Eigen::VectorXd& dx_c, Eigen::VectorXd& dx_p,
+                std::string* message) {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  std::vector<double> keep;
+  dampAndMask(m, L, lambda, H, b, keep);
+  if (cfg.layout.rolling) {
+    m.runner->run(kPointChunks, [&](int c) { schurChunk<14>(m, L, lambda, keep, c); });
+  } else {
+    m.runner->run(kPointChunks, [&](int c) { schurChunk<8>(m, L, lambda, keep, c); });
+  }
+  for (const ChunkSums& c : m.chunks) {
+    H -= c.H;
+    b -= c.b;
+  }
+  SolverStats st;
+  if (!solver.solveDense(H, b, dx_c, &st)) {
+    if (message) *message = st.message;
+    return false;
+  }
+  backSubstitute(m, L, lambda, cfg.layout.kfDim(), keep, dx_c, dx_p);
+  return true;
+}
+
+void fullSparse(const BundleAdjuster::Impl& m, const Linearization& L, int kd, double lambda,
+                Eigen::SparseMatrix<double>& S, Eigen::VectorXd& rhs, std::vector<double>& keep) {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  dampAndMask(m, L, lambda, H, b, keep);
+  const int np = static_cast<int>(m.points.size());
+  const int n = m.nc + np;
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int j = 0; j < m.nc; ++j)
+    for (int i = 0; i < m.nc; ++i)
+      if (H(i, j) != 0.0) trip.emplace_back(i, j, H(i, j));
+  rhs.setZero(n);
+  rhs.head(m.nc) = b;
+  for (int p = 0; p < np; ++p) {
+    const int row = m.nc + p;
+    const double Hpp = L.Hpp[static_cast<size_t>(p)] * (1.0 + lambda);
+    if (!(Hpp > kMinHpp)) {
+      trip.emplace_back(row, row, 1.0);
+      continue;
+    }
+    trip.emplace_back(row, row, Hpp);
+    rhs[row] = L.bp[static_cast<size_t>(p)];
+    const int ab = L.blk_begin[static_cast<size_t>(p)];
+    for (int a = 0; a < L.blk_count[static_cast<size_t>(p)]; ++a) {
+      const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
+      for (int k = 0; k < kd; ++k) {
+        const double v = L.hpc[static_cast<size_t>(ab + a) * kd + k] * keep[static_cast<size_t>(ia * kd + k)];
+        if (v == 0.0) continue;
+        trip.emplace_back(ia * kd + k, row, v);
+        trip.emplace_back(row, ia * kd + k, v);
+      }
+    }
+  }
+  S.resize(n, n);
+  S.setFromTriplets(trip.begin(), trip.end());  // duplicates (none expected) would be summed
+}
+
+bool solveFull(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdjustmentConfig& cfg,
+               SolverBackend& solver, double lambda, Eigen::VectorXd& dx_c, Eigen::VectorXd& dx_p,
+               std::string* message) {
+  Eigen::SparseMatrix<double> S;
+  Eigen::VectorXd rhs, x;
+  std::vector<double> keep;
+  fullSparse(m, L, cfg.layout.kfDim(), lambda, S, rhs, keep);
+  SolverStats st;
+  if (!solver.solveSparse(S, rhs, x, &st)) {
+    if (message) *message = st.message;
+    return false;
+  }
+  dx_c = x.head(m.nc);
+  dx_p = x.tail(static_cast<Eigen::Index>(m.points.size()));
+  return true;
+}
+
+// Writes the observation states and diagnostics of a linearisation back to the window.
+void writeBack(BundleAdjuster::Impl& m, const Linearization& L) {
+  for (size_t r = 0; r < m.obs_refs.size(); ++r) {
+    const ObsRef& ref = m.obs_refs[r];
+    ActiveObservation& o = m.points[static_cast<size_t>(ref.point)]->obs[static_cast<size_t>(ref.obs)];
+    const ObsLin& ol = L.obs[r];
+    o.state = ol.state;
+    o.energy = ol.energy;
+    o.u = ol.u;
+    o.v = ol.v;
+    o.grad_u = ol.grad_u;
+    o.grad_v = ol.grad_v;
+    o.mean_residual = ol.mean_r;
+    o.mean_weight = ol.mean_w;
+  }
+  for (size_t i = 0; i < m.points.size(); ++i) m.points[i]->idepth_hessian = L.Hpp[i];
+}
+
+void fillStats(const Linearization& L, BundleAdjustmentStats& s) {
+  s.photometric_energy = L.energy_photo_in;
+  s.num_in = L.num_in;
+  s.num_oob = L.num_oob;
+  s.num_outlier = L.num_outlier;
+  s.num_obs = L.num_in + L.num_oob + L.num_outlier;
+}
+
+}  // namespace
+}  // namespace ba
+
+BundleAdjuster::BundleAdjuster(const BundleAdjustmentConfig& config, const CameraModel& camera,
+                               const RowTiming& timing, SolverBackend& solver)
+    : config_(config), camera_(camera), timing_(timing), solver_(solver), impl_(new Impl) {
+  impl_->runner = std::make_unique<BlockRunner>(std::clamp(config.threads, 1, 2));
+}
+
+BundleAdjuster::~BundleAdjuster() = default;
+
+const std::vector<ActivePoint*>& BundleAdjuster::points() const { return impl_->points; }
+
+double BundleAdjuster::linearize(KeyframeList& window, const MarginalizationPrior& prior) {
+  Impl& m = *impl_;
+  m.prior = &prior;
+  ba::buildStructure(m, window, config_, nullptr);
+  ba::linearizePhotometric(m, m.cur, config_, camera_, timing_);
+  ba::addCameraTerms(m, m.cur, config_, terms_);
+  return m.cur.total();
+}
+
+bool BundleAdjuster::solveStep(double lambda, bool full, Eigen::VectorXd* dx_c, Eigen::VectorXd* dx_p,
+                               std::string* message) {
+  Eigen::VectorXd c, p;
+  const bool ok = full ? ba::solveFull(*impl_, impl_->cur, config_, solver_, lambda, c, p, message)
+                       : ba::solveSchur(*impl_, impl_->cur, config_, solver_, lambda, c, p, message);
+  if (dx_c) *dx_c = c;
+  if (dx_p) *dx_p = p;
+  return ok;
+}
+
+void BundleAdjuster::fullSystem(Eigen::MatrixXd* H, Eigen::VectorXd* b) const {
+  Eigen::SparseMatrix<double> S;
+  Eigen::VectorXd rhs;
+  std::vector<double> keep;
+  ba::fullSparse(*impl_, impl_->cur, config_.layout.kfDim(), 0.0, S, rhs, keep);
+  if (H) *H = Eigen::MatrixXd(S);
+  if (b) *b = rhs;
+}
+
+BundleAdjustmentStats BundleAdjuster::evaluate(KeyframeList& window, const MarginalizationPrior& prior) {
+  BundleAdjustmentStats s;
+  s.energy_initial = s.energy_final = linearize(window, prior);
+  ba::writeBack(*impl_, impl_->cur);
+  ba::fillStats(impl_->cur, s);
+  return s;
+}
+
+BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const MarginalizationPrior& prior,
+                                               int max_iterations) {
+  Impl& m = *impl_;
+  BundleAdjustmentStats s;
+  double e = linearize(window, prior);
+  s.energy_initial = e;
+  double lambda = config_.lambda_initial;
+  const bool full = solver_.prefersFullSystem();
+  std::vector<double> idepth_backup(m.points.size());
+  Eigen::VectorXd dx_c, dx_p;
+  const int kd = config_.layout.kfDim();
+  int failures = 0;
+  for (int it = 0; it < max_iterations; ++it) {
+    std::string msg;
+    const bool ok = full ? ba::solveFull(m, m.cur, config_, solver_, lambda, dx_c, dx_p, &msg)
+                         : ba::solveSchur(m, m.cur, config_, solver_, lambda, dx_c, dx_p, &msg);
+    if (!ok || !dx_c.allFinite() || !dx_p.allFinite()) {
+      s.message = msg.empty() ? "non-finite step" : msg;
+      lambda = std::max(lambda * 10.0, 1e-4);
+      if (++failures > 3) {
+        s.solver_failed = true;
+        break;
+      }
+      continue;
+    }
+    for (auto& kf : window) {
+      kf->backup = kf->state;
+      applyStep(kf->state, dx_c.segment(kf->index * kd, kd), config_.layout);
+    }
+    for (size_t i = 0; i < m.points.size(); ++i) {
+      ActivePoint& p = *m.points[i];
+      idepth_backup[i] = p.idepth;
+      p.idepth = std::max(p.idepth + dx_p[static_cast<Eigen::Index>(i)], 1e-6);
+    }
+    ba::linearizePhotometric(m, m.trial, config_, camera_, timing_);
+    ba::addCameraTerms(m, m.trial, config_, terms_);
+    ++s.iterations;
+    const double e_new = m.trial.total();
+    if (e_new < e) {
+      std::swap(m.cur, m.trial);
+      ++s.accepted;
+      const double rel = (e - e_new) / std::max(e, 1e-300);
+      e = e_new;
+      lambda *= 0.5;
+      if (rel < config_.step_threshold) break;
+    } else {
+      for (auto& kf : window) kf->state = kf->backup;
+      for (size_t i = 0; i < m.points.size(); ++i) m.points[i]->idepth = idepth_backup[i];
+      lambda *= 4.0;
+    }
+  }
+  s.energy_final = e;
+  s.lambda = lambda;
+  ba::writeBack(m, m.cur);
+  ba::fillStats(m.cur, s);
+  return s;
+}
+
+void BundleAdjuster::optimizeDepths(KeyframeList& window, const std::vector<ActivePoint*>& points, int iterations) {
+  Impl& m = *impl_;
+  m.prior = nullptr;
+  ba::buildStructure(m, window, config_, &points);
+  const size_t np = m.points.size();
+  auto pointEnergy = [&](const ba::Linearization& L, size_t i) {
+    double e = 0.0;
+    for (int r = m.point_obs_begin[i]; r < m.point_obs_begin[i + 1]; ++r) e += L.obs[static_cast<size_t>(r)].energy;
+    return e;
+  };
+  ba::linearizePhotometric(m, m.cur, config_, camera_, timing_);
+  std::vector<double> step(np, 0.0), energy(np), backup(np);
+  for (size_t i = 0; i < np; ++i) {
+    energy[i] = pointEnergy(m.cur, i);
+    step[i] = m.cur.Hpp[i] > 1e-8 ? m.cur.bp[i] / m.cur.Hpp[i] : 0.0;
+  }
+  for (int it = 0; it < iterations; ++it) {
+    for (size_t i = 0; i < np; ++i) {
+      backup[i] = m.points[i]->idepth;
+      m.points[i]->idepth = std::max(backup[i] + step[i], 1e-6);
+    }
+    ba::linearizePhotometric(m, m.trial, config_, camera_, timing_);
+    for (size_t i = 0; i < np; ++i) {
+      const double e = pointEnergy(m.trial, i);
+      if (e < energy[i]) {
+        energy[i] = e;
+        step[i] = m.trial.Hpp[i] > 1e-8 ? m.trial.bp[i] / m.trial.Hpp[i] : 0.0;
+        // Keep the accepted linearisation of this point in `cur`.
+        for (int r = m.point_obs_begin[i]; r < m.point_obs_begin[i + 1]; ++r)
+          m.cur.obs[static_cast<size_t>(r)] = m.trial.obs[static_cast<size_t>(r)];
+        m.cur.Hpp[i] = m.trial.Hpp[i];
+      } else {
+        m.points[i]->idepth = backup[i];
+        step[i] *= 0.5;
+      }
+    }
+  }
+  ba::writeBack(m, m.cur);
+}
+
+void BundleAdjuster::pointsTerm(const KeyframeList& window, const std::vector<ActivePoint*>& points, double weight,
+                                std::vector<int>* blocks, Eigen::MatrixXd* H, Eigen::VectorXd* b) {
+  Impl& m = *impl_;
+  m.prior = nullptr;
+  KeyframeList& w = const_cast<KeyframeList&>(window);  // reindexed only
+  ba::buildStructure(m, w, config_, &points);
+  ba::linearizePhotometric(m, m.cur, config_, camera_, timing_);
+  ba::writeBack(m, m.cur);  // the final linearisation of these observations (diagnostics log)
+  const int kd = config_.layout.kfDim();
+  // Schur complement over the points (no damping), fixed dimensions zeroed.
+  Eigen::MatrixXd Hf;
+  Eigen::VectorXd bf;
+  std::vector<double> keep(static_cast<size_t>(m.nc), 1.0);
+  for (int i = 0; i < m.nc; ++i) keep[static_cast<size_t>(i)] = m.fixed[static_cast<size_t>(i)] ? 0.0 : 1.0;
+  if (config_.layout.rolling) {
+    m.runner->run(ba::kPointChunks, [&](int c) { ba::schurChunk<14>(m, m.cur, 0.0, keep, c); });
+  } else {
+    m.runner->run(ba::kPointChunks, [&](int c) { ba::schurChunk<8>(m, m.cur, 0.0, keep, c); });
+  }
+  Hf = m.cur.Hcc;
+  bf = m.cur.bc;
+  for (const ba::ChunkSums& c : m.chunks) {
+    Hf -= c.H;
+    bf -= c.b;
+  }
+  for (int i = 0; i < m.nc; ++i) {
+    if (keep[static_cast<size_t>(i)] != 0.0) continue;
+    Hf.row(i).setZero();
+    Hf.col(i).setZero();
+    bf[i] = 0.0;
+  }
+  Hf *= weight;
+  bf *= weight;
+  std::vector<int> blk;
+  for (int k = 0; k < static_cast<int>(window.size()); ++k)
+    if (Hf.block(k * kd, 0, kd, m.nc).cwiseAbs().maxCoeff() > 0.0) blk.push_back(k);
+  const Eigen::Index n = static_cast<Eigen::Index>(blk.size()) * kd;
+  H->resize(n, n);
+  b->resize(n);
+  for (size_t i = 0; i < blk.size(); ++i) {
+    b->segment(static_cast<Eigen::Index>(i) * kd, kd) = bf.segment(blk[i] * kd, kd);
+    for (size_t j = 0; j < blk.size(); ++j)
+      H->block(static_cast<Eigen::Index>(i) * kd, static_cast<Eigen::Index>(j) * kd, kd, kd) =
+          Hf.block(blk[i] * kd, blk[j] * kd, kd, kd);
+  }
+  *blocks = blk;
+}
+
+void BundleAdjuster::keyframePriorTerm(const Keyframe& kf, Eigen::MatrixXd* H, Eigen::VectorXd* b) const {
+  const int kd = config_.layout.kfDim();
+  H->setZero(kd, kd);
+  b->setZero(kd);
+  ba::keyframePriors(kf, config_, *H, *b);
+  for (int i = 0; i < kd; ++i) {
+    const bool fixed = (kf.gauge && i < 8) ||
+                       (!config_.estimate_affine && (i == StateLayout::kAffine || i == StateLayout::kAffine + 1));
+    if (!fixed) continue;
+    H->row(i).setZero();
+    H->col(i).setZero();
+    (*b)[i] = 0.0;
+  }
+}
+
+}  // namespace rsvio

@@ -1,0 +1,338 @@
+// Monocular initialisation: corner tracks, 8-point essential matrix in RANSAC, pose and scale
+// (contract in rsvio/backend/mono_initializer.h).
+#include "rsvio/backend/mono_initializer.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+
+#include "rsvio/interfaces/camera.h"
+
+namespace rsvio {
+namespace {
+
+constexpr int kHalfWin = 4;       // 9x9 Lucas-Kanade window
+constexpr int kLkIterations = 12;
+constexpr int kRansacIterations = 400;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// Pyramidal Lucas-Kanade of one point from `a` to `b` (zero-mean SSD over a 9x9 window, inverse
+// compositional per level). Returns false when the point leaves an image or the window is flat.
+bool trackPoint(const ImagePyramid& a, const ImagePyramid& b, const Vec2& p0, const Vec2& guess0, Vec2* out) {
+  int levels = std::min({a.numLevels(), b.numLevels(), 5});
+  while (levels > 1 && std::min(a.level(levels - 1).width(), a.level(levels - 1).height()) < 6 * kHalfWin) --levels;
+  constexpr int n = (2 * kHalfWin + 1) * (2 * kHalfWin + 1);
+  float T[n], GX[n], GY[n];
+  Vec2 d = (guess0 - p0) / std::pow(2.0, levels - 1);
+  for (int l = levels - 1; l >= 0; --l) {
+    const ImageLevel& la = a.level(l);
+    const ImageLevel& lb = b.level(l);
+    const float pu = la.toLevel(static_cast<float>(p0.x())), pv = la.toLevel(static_cast<float>(p0.y()));
+    // A window that does not fit a coarse level (near the border): that level is skipped.
+    const bool fits = la.inside(pu, pv, kHalfWin + 1.f) &&
+                      lb.inside(pu + static_cast<float>(d.x()), pv + static_cast<float>(d.y()), kHalfWin + 1.f);
+    if (!fits) {
+      if (l == 0) return false;
+      d *= 2.0;
+      continue;
+    }
+    double h00 = 0, h01 = 0, h11 = 0, mean_t = 0;
+    float s[4];
+    int k = 0;
+    for (int dy = -kHalfWin; dy <= kHalfWin; ++dy)
+      for (int dx = -kHalfWin; dx <= kHalfWin; ++dx, ++k) {
+        la.sample(pu + dx, pv + dy, s);
+        T[k] = s[0];
+        GX[k] = s[1];
+        GY[k] = s[2];
+        mean_t += s[0];
+      }
+    mean_t /= n;
+    double mgx = 0, mgy = 0;
+    for (k = 0; k < n; ++k) {
+      mgx += GX[k];
+      mgy += GY[k];
+    }
+    mgx /= n;
+    mgy /= n;
+    for (k = 0; k < n; ++k) {  // zero-mean residual: the mean gradient drops out of the Hessian too
+      GX[k] -= static_cast<float>(mgx);
+      GY[k] -= static_cast<float>(mgy);
+      h00 += GX[k] * GX[k];
+      h01 += GX[k] * GY[k];
+      h11 += GY[k] * GY[k];
+    }
+    const double det = h00 * h11 - h01 * h01;
+    if (!(det > 1e-6 * (h00 + h11) * (h00 + h11)) || !(h00 + h11 > 1e-3)) return false;
+    for (int it = 0; it < kLkIterations; ++it) {
+      const float qu = pu + static_cast<float>(d.x()), qv = pv + static_cast<float>(d.y());
+      if (!lb.inside(qu, qv, kHalfWin + 1.f)) return false;
+      float I[n];
+      double mean_i = 0;
+      k = 0;
+      for (int dy = -kHalfWin; dy <= kHalfWin; ++dy)
+        for (int dx = -kHalfWin; dx <= kHalfWin; ++dx, ++k) {
+          I[k] = lb.sampleIntensity(qu + dx, qv + dy);
+          mean_i += I[k];
+        }
+      mean_i /= n;
+      double b0 = 0, b1 = 0;
+      for (k = 0; k < n; ++k) {
+        const double e = (I[k] - mean_i) - (T[k] - mean_t);
+        b0 += GX[k] * e;
+        b1 += GY[k] * e;
+      }
+      const Vec2 step((h11 * b0 - h01 * b1) / det, (h00 * b1 - h01 * b0) / det);
+      d -= step;
+      if (step.squaredNorm() < 1e-4) break;
+    }
+    if (l > 0) d *= 2.0;
+  }
+  *out = p0 + d;
+  return std::isfinite(out->x()) && std::isfinite(out->y());
+}
+
+using Mat3d = Eigen::Matrix3d;
+
+// Hartley normalisation of 2D points: T maps them to zero mean and mean distance sqrt(2).
+Mat3d normaliser(const std::vector<Eigen::Vector2d>& x, const std::vector<int>& idx) {
+  Eigen::Vector2d m = Eigen::Vector2d::Zero();
+  for (int i : idx) m += x[static_cast<size_t>(i)];
+  m /= static_cast<double>(idx.size());
+  double s = 0;
+  for (int i : idx) s += (x[static_cast<size_t>(i)] - m).norm();
+  s = std::sqrt(2.0) * static_cast<double>(idx.size()) / std::max(s, 1e-12);
+  Mat3d T;
+  T << s, 0, -s * m.x(), 0, s, -s * m.y(), 0, 0, 1;
+  return T;
+}
+
+// Linear 8-point (or more) essential matrix, x2^T E x1 = 0, projected onto the essential manifold.
+Mat3d eightPoint(const std::vector<Eigen::Vector2d>& x1, const std::vector<Eigen::Vector2d>& x2,
+                 const std::vector<int>& idx) {
+  const Mat3d T1 = normaliser(x1, idx), T2 = normaliser(x2, idx);
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(idx.size()), 9);
+  for (size_t r = 0; r < idx.size(); ++r) {
+    const Eigen::Vector3d a = T1 * x1[static_cast<size_t>(idx[r])].homogeneous();
+    const Eigen::Vector3d b = T2 * x2[static_cast<size_t>(idx[r])].homogeneous();
+    A.row(static_cast<Eigen::Index>(r)) << b.x() * a.x(), b.x() * a.y(), b.x(), b.y() * a.x(), b.y() * a.y(), b.y(),
+        a.x(), a.y(), 1.0;
+  }
+  Eigen::Matrix<double, 9, 9> AtA = A.transpose() * A;
+  Eigen::JacobiSVD<Eigen::Matrix<double, 9, 9>> svd(AtA, Eigen::ComputeFullV);
+  const Eigen::Matrix<double, 9, 1> e = svd.matrixV().col(8);
+  Mat3d En;
+  En << e[0], e[1], e[2], e[3], e[4], e[5], e[6], e[7], e[8];
+  Mat3d E = T2.transpose() * En * T1;
+  Eigen::JacobiSVD<Mat3d> s2(E, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const double sv = 0.5 * (s2.singularValues()[0] + s2.singularValues()[1]);
+  return s2.matrixU() * Eigen::Vector3d(sv, sv, 0).asDiagonal() * s2.matrixV().transpose();
+}
+
+double sampson(const Mat3d& E, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector3d x1 = a.homogeneous(), x2 = b.homogeneous();
+  const Eigen::Vector3d Ex1 = E * x1, Etx2 = E.transpose() * x2;
+  const double num = x2.dot(Ex1);
+  const double den = Ex1.head<2>().squaredNorm() + Etx2.head<2>().squaredNorm();
+  return den > 0 ? num * num / den : 1e30;
+}
+
+// Depths of the two rays (bearings b1 in camera 1, b2 in camera 2, x2 = R x1 + t) at their closest points.
+bool triangulate(const Mat3d& R, const Eigen::Vector3d& t, const Eigen::Vector3d& b1, const Eigen::Vector3d& b2,
+                 double* d1, double* d2) {
+  Eigen::Matrix<double, 3, 2> A;
+  A.col(0) = R * b1;
+  A.col(1) = -b2;
+  const Eigen::Matrix2d AtA = A.transpose() * A;
+  const double det = AtA.determinant();
+  if (!(std::abs(det) > 1e-12)) return false;
+  const Eigen::Vector2d l = AtA.inverse() * (A.transpose() * (-t));
+  *d1 = l[0];
+  *d2 = l[1];
+  return true;
+}
+
+}  // namespace
+
+MonoInitializer::MonoInitializer(const BackendOptions& options, const CameraModel& camera)
+    : options_(options), camera_(camera) {}
+
+void MonoInitializer::reset(int64_t frame_index) {
+  const ImageLevel& l0 = prev_->level(0);
+  cv::Mat img8(l0.height(), l0.width(), CV_8U);
+  for (int y = 0; y < l0.height(); ++y)
+    for (int x = 0; x < l0.width(); ++x)
+      img8.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(l0.intensity(x, y));
+  std::vector<cv::Point2f> corners;
+  const double diag = std::hypot(l0.width(), l0.height());
+  cv::Mat mask = cv::Mat::zeros(img8.size(), CV_8U);
+  const int border = 12;
+  mask(cv::Rect(border, border, std::max(1, img8.cols - 2 * border), std::max(1, img8.rows - 2 * border))) = 255;
+  cv::goodFeaturesToTrack(img8, corners, options_.init_corners, 0.01, std::max(3.0, diag / 60.0), mask, 5);
+  ref_pts_ = corners;
+  cur_pts_ = corners;
+  initial_tracks_ = static_cast<int>(corners.size());
+  ref_index_ = frame_index;
+  frames_since_ref_ = 0;
+}
+
+bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int64_t frame_index) {
+  if (!prev_ || ref_index_ < 0) {
+    prev_ = std::move(pyramid);
+    reset(frame_index);
+    status_ = "reference frame set (" + std::to_string(initial_tracks_) + " corners)";
+    return false;
+  }
+  // Frame-to-frame tracks with a forward-backward check.
+  std::vector<cv::Point2f> ref_kept, cur_kept;
+  for (size_t i = 0; i < cur_pts_.size(); ++i) {
+    const Vec2 p(cur_pts_[i].x, cur_pts_[i].y);
+    Vec2 q, back;
+    if (!trackPoint(*prev_, *pyramid, p, p, &q)) continue;
+    if (!trackPoint(*pyramid, *prev_, q, p, &back) || (back - p).norm() > 1.0) continue;
+    ref_kept.push_back(ref_pts_[i]);
+    cur_kept.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
+  }
+  ref_pts_.swap(ref_kept);
+  cur_pts_.swap(cur_kept);
+  prev_ = std::move(pyramid);
+  ++frames_since_ref_;
+  if (static_cast<int>(cur_pts_.size()) < std::max(30, initial_tracks_ / 3)) {
+    status_ = "lost corner tracks (" + std::to_string(cur_pts_.size()) + "), new reference";
+    reset(frame_index);
+    return false;
+  }
+  if (frames_since_ref_ < options_.init_min_frames) {
+    status_ = "waiting for frames";
+    return false;
+  }
+  return tryInitialise();
+}
+
+bool MonoInitializer::tryInitialise() {
+  const int w = camera_.width(), h = camera_.height();
+  std::vector<double> flow;
+  for (size_t i = 0; i < cur_pts_.size(); ++i) flow.push_back(std::hypot(cur_pts_[i].x - ref_pts_[i].x, cur_pts_[i].y - ref_pts_[i].y));
+  const double med_flow = median(flow);
+  if (med_flow < options_.init_min_flow_px * std::hypot(w, h)) {
+    std::ostringstream os;
+    os << "median corner flow " << med_flow << " px is small";
+    status_ = os.str();
+    return false;
+  }
+  // Unit-focal image-plane coordinates through the camera's own unprojection.
+  const Eigen::Index n = static_cast<Eigen::Index>(cur_pts_.size());
+  Eigen::Matrix2Xd u1(2, n), u2(2, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    u1.col(i) << ref_pts_[static_cast<size_t>(i)].x, ref_pts_[static_cast<size_t>(i)].y;
+    u2.col(i) << cur_pts_[static_cast<size_t>(i)].x, cur_pts_[static_cast<size_t>(i)].y;
+  }
+  Eigen::Matrix3Xd b1, b2;
+  std::vector<uint8_t> v1, v2;
+  camera_.unproject(u1, b1, v1);
+  camera_.unproject(u2, b2, v2);
+  std::vector<Eigen::Vector2d> x1, x2;
+  std::vector<Eigen::Vector3d> B1, B2;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!v1[static_cast<size_t>(i)] || !v2[static_cast<size_t>(i)] || b1(2, i) < 0.1 || b2(2, i) < 0.1) continue;
+    x1.emplace_back(b1(0, i) / b1(2, i), b1(1, i) / b1(2, i));
+    x2.emplace_back(b2(0, i) / b2(2, i), b2(1, i) / b2(2, i));
+    B1.push_back(b1.col(i).normalized());
+    B2.push_back(b2.col(i).normalized());
+  }
+  const int m = static_cast<int>(x1.size());
+  if (m < 20) {
+    status_ = "too few corners for the essential matrix";
+    return false;
+  }
+  const double f = camera_.calibration().intrinsics[0] > 0 ? camera_.calibration().intrinsics[0] : 500.0;
+  const double thr = (1.0 / f) * (1.0 / f);
+  std::mt19937_64 rng(0x5eed1234u + static_cast<uint64_t>(ref_index_));
+  std::vector<int> best_in;
+  std::vector<int> sample(8);
+  for (int it = 0; it < kRansacIterations; ++it) {
+    for (int k = 0; k < 8; ++k) {
+      int c;
+      do {
+        c = static_cast<int>(rng() % static_cast<uint64_t>(m));
+      } while (std::find(sample.begin(), sample.begin() + k, c) != sample.begin() + k);
+      sample[static_cast<size_t>(k)] = c;
+    }
+    const Mat3d E = eightPoint(x1, x2, sample);
+    std::vector<int> in;
+    for (int i = 0; i < m; ++i)
+      if (sampson(E, x1[static_cast<size_t>(i)], x2[static_cast<size_t>(i)]) < thr) in.push_back(i);
+    if (in.size() > best_in.size()) best_in.swap(in);
+  }
+  if (best_in.size() < 8) {
+    status_ = "no essential matrix";
+    return false;
+  }
+  // Refit on the inliers (twice, re-selecting inliers).
+  Mat3d E = eightPoint(x1, x2, best_in);
+  for (int rep = 0; rep < 2; ++rep) {
+    std::vector<int> in;
+    for (int i = 0; i < m; ++i)
+      if (sampson(E, x1[static_cast<size_t>(i)], x2[static_cast<size_t>(i)]) < thr) in.push_back(i);
+    if (in.size() < 8) break;
+    best_in.swap(in);
+    E = eightPoint(x1, x2, best_in);
+  }
+  const double inlier_ratio = static_cast<double>(best_in.size()) / m;
+  // The four decompositions; the one with most points in front of both cameras.
+  Eigen::JacobiSVD<Mat3d> svd(E, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3d U = svd.matrixU(), V = svd.matrixV();
+  if (U.determinant() < 0) U = -U;
+  if (V.determinant() < 0) V = -V;
+  Mat3d Wm;
+  Wm << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  const Mat3d Rs[2] = {U * Wm * V.transpose(), U * Wm.transpose() * V.transpose()};
+  int best_front = -1;
+  Mat3d R_best;
+  Eigen::Vector3d t_best;
+  std::vector<double> depth_best, angle_best;
+  for (const Mat3d& R : Rs)
+    for (double sgn : {1.0, -1.0}) {
+      const Eigen::Vector3d t = sgn * U.col(2);
+      int front = 0;
+      std::vector<double> depth, angle;
+      for (int i : best_in) {
+        double d1 = 0, d2 = 0;
+        if (!triangulate(R, t, B1[static_cast<size_t>(i)], B2[static_cast<size_t>(i)], &d1, &d2)) continue;
+        if (d1 > 0 && d2 > 0) {
+          ++front;
+          depth.push_back(d1);
+          angle.push_back(std::acos(std::clamp(B1[static_cast<size_t>(i)].dot(R.transpose() * B2[static_cast<size_t>(i)]), -1.0, 1.0)));
+        }
+      }
+      if (front > best_front) {
+        best_front = front;
+        R_best = R;
+        t_best = t;
+        depth_best = depth;
+        angle_best = angle;
+      }
+    }
+  parallax_deg_ = median(angle_best) * 180.0 / M_PI;
+  std::ostringstream os;
+  os << "essential matrix: " << best_in.size() << "/" << m << " inliers, " << best_front << " in front, median parallax "
+     << parallax_deg_ << " deg";
+  status_ = os.str();
+  if (inlier_ratio < options_.init_min_inlier_ratio || best_front < 0.9 * static_cast<double>(best_in.size()) ||
+      parallax_deg_ < options_.init_min_parallax_deg || depth_best.size() < 10)
+    return false;
+  const double med_depth = median(depth_best);
+  if (!(med_depth > 0)) return false;
+  T_cur_ref_ = SE3d(Eigen::Quaterniond(R_best).normalized(), t_best / med_depth);
+  return true;
+}
+
+}  // namespace rsvio

@@ -1,0 +1,163 @@
+#include "rsvio/pipeline/run.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "rsvio/config/config.h"
+#include "rsvio/config/validate.h"
+#include "rsvio/core/error.h"
+#include "rsvio/eval/eval_output.h"
+#include "rsvio/eval/evaluate_files.h"
+#include "rsvio/interfaces/data_source.h"
+#include "rsvio/io/ply.h"
+#include "rsvio/io/trajectory.h"
+#include "rsvio/plugin/host.h"
+#include "rsvio/system/odometry.h"
+
+namespace fs = std::filesystem;
+
+namespace rsvio {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Writes everything the odometry has, even after a failure. Returns problems as warnings.
+void writeOutputs(const Odometry& odo, const std::string& out, const nlohmann::json& cfg,
+                  std::vector<std::string>& warnings) {
+  auto guarded = [&](const char* what, const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      warnings.push_back(std::string("could not write ") + what + ": " + e.what());
+    }
+  };
+  guarded("trajectory.tum", [&] { io::writeTum((fs::path(out) / "trajectory.tum").string(), odo.frameTrajectory()); });
+  guarded("keyframes.tum",
+          [&] { io::writeTum((fs::path(out) / "keyframes.tum").string(), odo.keyframeTrajectory()); });
+  guarded("states.csv", [&] { writeStates(odo.states(), (fs::path(out) / "states.csv").string()); });
+  if (cfg.at("output").at("points").get<bool>()) {
+    guarded("points.ply", [&] {
+      io::PointCloud cloud;
+      for (const auto& p : odo.points()) {
+        cloud.p_W.push_back(p.p_w.cast<double>());
+        cloud.intensity.push_back(p.intensity);
+      }
+      io::writePly((fs::path(out) / "points.ply").string(), cloud);
+    });
+  }
+  if (cfg.at("output").at("diagnostics").get<bool>())
+    guarded("diagnostics.bin", [&] { odo.diagnostics().write((fs::path(out) / "diagnostics.bin").string()); });
+}
+
+// ATE on keyframes (conventions.md: report.json's ATE is on keyframes, paper eq. 35).
+void evaluate(const std::string& data_dir, const std::string& out, Report& report) {
+  if (!io::findDatasetGroundTruth(data_dir)) return;
+  const std::string est = (fs::path(out) / "keyframes.tum").string();
+  try {
+    eval::FileEvalRequest req;
+    req.dataset_dir = data_dir;
+    req.est_path = est;
+    auto outcome = eval::evaluateFiles(req);
+    ReportEval e;
+    e.ate_rmse_m = outcome.result.ate_m.rmse;
+    e.align = eval::alignModeName(outcome.result.alignment.mode);
+    e.details = eval::evalToJson(outcome.result, outcome.context);
+    e.details["on"] = "keyframes";
+    report.eval = e;
+  } catch (const std::exception& ex) {
+    report.warnings.push_back(std::string("evaluation skipped: ") + ex.what());
+  }
+}
+
+}  // namespace
+
+nlohmann::json loadRunConfig(const std::string& path, const std::vector<std::string>& sets, PluginHost& host) {
+  nlohmann::json raw = loadConfigWithSets(path, sets);
+  return validateConfig(raw, runConfigSchema(), host, path);
+}
+
+RunResult runPipeline(const RunRequest& request, PluginHost& host) {
+  RunResult result;
+  nlohmann::json cfg = loadRunConfig(request.config_path, request.sets, host);
+  if (request.seed >= 0) cfg["seed"] = request.seed;
+  if (cfg["name"].get<std::string>().empty()) cfg["name"] = fs::path(request.config_path).stem().string();
+  result.effective_config = cfg;
+  result.out_dir = request.out_dir;
+
+  std::error_code ec;
+  fs::create_directories(request.out_dir, ec);
+  if (ec) throw Error(request.out_dir + ": cannot create output folder: " + ec.message());
+  writeConfig(cfg, (fs::path(request.out_dir) / "config.json").string());
+
+  auto source = host.create<DataSource>(cfg["source"]["plugin"], slotParams(cfg, "source"), "source");
+  source->open(request.data_dir);
+  const SensorSetup& sensors = source->sensors();
+
+  Report& report = result.report;
+  report.dataset = fs::absolute(request.data_dir).lexically_normal().string();
+  report.config = cfg["name"];
+  report.seed = cfg["seed"];
+  report.threads = cfg["threads"];
+  report.camera_rate_hz = sensors.camera.rate_hz;
+  for (const auto& w : source->warnings()) report.warnings.push_back(w);
+
+  const auto t_start = Clock::now();
+  Odometry odo(cfg, host, sensors);
+  const auto& imu = source->imu();
+  size_t imu_next = 0;
+  const size_t n = source->numFrames();
+  const double rate = sensors.camera.rate_hz > 0 ? sensors.camera.rate_hz : 20.0;
+  const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(sensors.camera.time_offset_s);
+  auto last_print = Clock::now();
+  long processed = 0;
+  for (size_t i = 0; i < n && !odo.failed(); ++i) {
+    const int64_t t_f = source->frameTime(i);
+    while (imu_next < imu.size() && imu[imu_next].t_ns <= t_f + lookahead_ns) odo.addImu(imu[imu_next++]);
+    Frame frame;
+    try {
+      frame = source->readFrame(i);
+    } catch (const Error& e) {
+      report.status = "failed";
+      report.error = e.what();
+      break;
+    }
+    const FrameStatus st = odo.addFrame(frame);
+    ++processed;
+    const bool print_now = request.verbosity >= 2 || (request.verbosity >= 1 && secondsSince(last_print) > 2.0);
+    if (print_now || (request.verbosity >= 1 && i + 1 == n)) {
+      const double el = secondsSince(t_start);
+      std::printf("[%zu/%zu] %.1f fps (camera %.0f Hz), %ld keyframes%s%s\n", i + 1, n,
+                  el > 0 ? processed / el : 0.0, rate, odo.numKeyframes(), st.message.empty() ? "" : ", ",
+                  st.message.c_str());
+      std::fflush(stdout);
+      last_print = Clock::now();
+    }
+  }
+  if (!odo.failed() && report.status == "ok") odo.finish();
+  const double wall = secondsSince(t_start);
+  if (odo.failed()) {
+    report.status = "failed";
+    report.error = odo.failureReason();
+  }
+  report.frames = processed;
+  report.keyframes = odo.numKeyframes();
+  report.fps = wall > 0 ? processed / wall : 0.0;
+  report.realtime_factor = report.fps / rate;
+  report.stage_ms = odo.stageMs();
+  if (odo.usesImu()) report.scale = odo.scale();
+  for (const auto& w : odo.warnings()) report.warnings.push_back(w);
+
+  writeOutputs(odo, request.out_dir, cfg, report.warnings);
+  if (cfg["output"]["evaluate"].get<bool>() && report.ok()) evaluate(request.data_dir, request.out_dir, report);
+  report.write((fs::path(request.out_dir) / "report.json").string());
+  return result;
+}
+
+}  // namespace rsvio

@@ -1,0 +1,432 @@
+// Keyframes and points (DSO's makeKeyFrame order, Engel et al. 2018, sec. 3): flag keyframes to
+// marginalise, add the keyframe and every active point's observation in it, activate candidates,
+// optimise the window, set the tracking reference, remove outliers and marginalise leaving points,
+// create the new keyframe's candidates, marginalise the flagged keyframes, check for divergence.
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "odometry_impl.h"
+#include "rsvio/backend/keyframe_policy.h"
+#include "rsvio/core/time.h"
+#include "rsvio/photometric/pixel_selector.h"
+
+namespace rsvio {
+namespace {
+
+RsFrame rsFrame(const Keyframe& kf, bool rolling) { return RsFrame{kf.state.T_c_w, rolling ? kf.state.twist : Vec6::Zero()}; }
+
+// World point of a host point (fixed at its host row time, rs_projection.h).
+Vec3 worldPoint(const Keyframe& host, const Vec3& bearing, double v, double idepth, const RowTiming& timing,
+                bool rolling) {
+  Vec3 Z = bearing / idepth;
+  if (rolling) Z = SE3d::exp(-host.state.twist * timing.rowTime(v)) * Z;
+  return host.state.T_c_w.inverse() * Z;
+}
+
+}  // namespace
+
+int Odometry::Impl::numActivePoints() const {
+  int n = 0;
+  for (const auto& kf : window) n += static_cast<int>(kf->points.size());
+  return n;
+}
+
+double Odometry::Impl::medianIdepth() const {
+  std::vector<double> v;
+  for (const auto& kf : window)
+    for (const ActivePoint& p : kf->points) v.push_back(p.idepth);
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+void Odometry::Impl::traceCandidates(const ImagePyramid& pyr, const SE3d& T_c_w, const AffineBrightness& affine,
+                                     double exposure_ms) {
+  CandidateFrame target;
+  target.pose = RsFrame{T_c_w, rolling ? velocityEstimate() : Vec6::Zero()};
+  target.affine = affine;
+  target.exposure_ms = exposure_ms;
+  for (auto& kf : window) {
+    if (kf->candidates.empty()) continue;
+    CandidateFrame host;
+    host.pose = rsFrame(*kf, rolling);
+    host.affine = kf->state.affine;
+    host.exposure_ms = kf->exposure_ms;
+    tracer->trace(kf->candidates, host, target, pyr.level(0));
+  }
+}
+
+void Odometry::Impl::createCandidates(Keyframe& kf) {
+  PixelSelectorOptions so = fo.select;
+  so.seed = seed * 1000003ULL + static_cast<uint64_t>(kf.kf_id);
+  const std::vector<SelectedPixel> px = PixelSelector(so).select(*kf.pyramid);
+  std::vector<Vec2> pixels;
+  pixels.reserve(px.size());
+  for (const SelectedPixel& p : px) pixels.emplace_back(p.u, p.v);
+  kf.candidates = tracer->create(kf.pyramid->level(0), pixels);
+}
+
+void Odometry::Impl::activateCandidates(Keyframe& newest) {
+  // DSO's adaptive distance between active points (activatePointsMT).
+  const int n = numActivePoints();
+  const double N = bo.active_points;
+  if (n < N * 0.66) min_act_dist -= 0.8;
+  if (n < N * 0.8) min_act_dist -= 0.5;
+  else if (n < N * 0.9) min_act_dist -= 0.2;
+  else if (n < N) min_act_dist -= 0.1;
+  if (n > N * 1.5) min_act_dist += 0.8;
+  if (n > N * 1.3) min_act_dist += 0.5;
+  if (n > N * 1.15) min_act_dist += 0.2;
+  if (n > N) min_act_dist += 0.1;
+  min_act_dist = std::clamp(min_act_dist, 0.0, 4.0);
+
+  // Distance map on level 1 of the newest keyframe: distance to the nearest active point.
+  const int lvl = newest.pyramid->numLevels() > 1 ? 1 : 0;
+  const ImageLevel& L = newest.pyramid->level(lvl);
+  cv::Mat free_px(L.height(), L.width(), CV_8U, cv::Scalar(255));
+  RsProjectionOptions popt;
+  popt.jacobians = false;
+  std::vector<RsHostProjection> proj;
+  const RsFrame target = rsFrame(newest, rolling);
+  auto toLevel = [&](const Vec2& uv, int* x, int* y) {
+    *x = static_cast<int>(std::lround(L.toLevel(static_cast<float>(uv.x()))));
+    *y = static_cast<int>(std::lround(L.toLevel(static_cast<float>(uv.y()))));
+    return *x >= 0 && *y >= 0 && *x < L.width() && *y < L.height();
+  };
+  int occupied = 0;
+  for (auto& host : window) {
+    if (host.get() == &newest || host->points.empty()) continue;
+    const Eigen::Index np = static_cast<Eigen::Index>(host->points.size());
+    Eigen::Matrix3Xd b(3, np);
+    Eigen::VectorXd vh(np), rho(np);
+    for (Eigen::Index i = 0; i < np; ++i) {
+      const ActivePoint& p = host->points[static_cast<size_t>(i)];
+      b.col(i) = p.bearing;
+      vh[i] = p.v;
+      rho[i] = p.idepth;
+    }
+    projectRollingShutter(*camera, timing, rsFrame(*host, rolling), target, b, vh, rho, proj, popt);
+    for (const RsHostProjection& pr : proj) {
+      int x, y;
+      if (pr.valid && toLevel(pr.uv, &x, &y)) {
+        free_px.at<uint8_t>(y, x) = 0;
+        ++occupied;
+      }
+    }
+  }
+  cv::Mat dist;
+  if (occupied > 0) {
+    cv::distanceTransform(free_px, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  } else {
+    dist = cv::Mat(L.height(), L.width(), CV_32F, cv::Scalar(1e6f));
+  }
+  const int R = static_cast<int>(std::ceil(min_act_dist));
+  auto stamp = [&](int x, int y) {
+    for (int dy = -R; dy <= R; ++dy)
+      for (int dx = -R; dx <= R; ++dx) {
+        const int xx = x + dx, yy = y + dy;
+        if (xx < 0 || yy < 0 || xx >= dist.cols || yy >= dist.rows) continue;
+        float& d = dist.at<float>(yy, xx);
+        d = std::min(d, static_cast<float>(std::sqrt(dx * dx + dy * dy)));
+      }
+  };
+
+  std::vector<std::pair<Keyframe*, size_t>> new_points;  // host, index into host->points
+  for (auto& host : window) {
+    if (host.get() == &newest || host->candidates.empty()) continue;
+    std::vector<CandidatePoint>& C = host->candidates;
+    const Eigen::Index nc = static_cast<Eigen::Index>(C.size());
+    Eigen::Matrix3Xd b(3, nc);
+    Eigen::VectorXd vh(nc), rho(nc);
+    for (Eigen::Index i = 0; i < nc; ++i) {
+      const CandidatePoint& c = C[static_cast<size_t>(i)];
+      b.col(i) = c.bearing;
+      vh[i] = c.uv.y();
+      rho[i] = c.hasDepth() ? std::max(c.idepth(), 1e-6) : 0.0;  // 0: not traced yet, left out
+    }
+    projectRollingShutter(*camera, timing, rsFrame(*host, rolling), target, b, vh, rho, proj, popt);
+    std::vector<CandidatePoint> keep;
+    keep.reserve(C.size());
+    for (Eigen::Index i = 0; i < nc; ++i) {
+      const CandidatePoint& c = C[static_cast<size_t>(i)];
+      if (c.status == CandidateStatus::OutOfBounds) continue;
+      if (!c.hasDepth()) {
+        keep.push_back(c);
+        continue;
+      }
+      const RsHostProjection& pr = proj[static_cast<size_t>(i)];
+      if (!pr.valid || !camera->inImage(pr.uv, 4.0)) continue;  // left the view of the newest keyframe
+      int x, y;
+      if (!c.readyForActivation(fo.trace) || !toLevel(pr.uv, &x, &y) || dist.at<float>(y, x) < min_act_dist) {
+        keep.push_back(c);
+        continue;
+      }
+      stamp(x, y);
+      ActivePoint p;
+      p.host = host.get();
+      p.id = next_point_id++;
+      p.u = static_cast<float>(c.uv.x());
+      p.v = static_cast<float>(c.uv.y());
+      p.bearing = c.bearing;
+      p.d_bearing_d_uv = c.d_bearing_d_uv;
+      p.idepth = std::max(c.idepth(), 1e-6);
+      p.pattern = c.pattern;
+      for (auto& t : window)
+        if (t.get() != host.get()) p.obs.push_back(ActiveObservation{t.get()});
+      host->points.push_back(p);
+      new_points.emplace_back(host.get(), host->points.size() - 1);
+    }
+    C.swap(keep);
+  }
+  if (new_points.empty()) return;
+  std::vector<ActivePoint*> ptrs;
+  for (const auto& [h, i] : new_points) ptrs.push_back(&h->points[i]);
+  ba->optimizeDepths(window, ptrs, bo.activation_iterations);
+  // Keep the observations that fit; drop points that fit nowhere (DSO: at least one good residual).
+  for (ActivePoint* p : ptrs) {
+    p->obs.erase(std::remove_if(p->obs.begin(), p->obs.end(),
+                                [](const ActiveObservation& o) { return o.state != ObsState::kIn; }),
+                 p->obs.end());
+  }
+  for (auto& host : window) {
+    auto& P = host->points;
+    P.erase(std::remove_if(P.begin(), P.end(), [](const ActivePoint& p) { return p.obs.empty() || !(p.idepth > 1e-5); }),
+            P.end());
+  }
+}
+
+void Odometry::Impl::setTrackingReference(const Keyframe& newest) {
+  TrackingReference ref;
+  ref.frame_id = newest.frame_index;
+  ref.t_ns = newest.t_ns;
+  ref.T_c_w = newest.state.T_c_w;
+  ref.twist = rolling ? newest.state.twist : Vec6::Zero();
+  ref.affine = newest.state.affine;
+  ref.exposure_ms = newest.exposure_ms;
+  ref.pyramid = newest.pyramid;
+  RsProjectionOptions popt;
+  popt.jacobians = false;
+  std::vector<RsHostProjection> proj;
+  const RsFrame target = rsFrame(newest, rolling);
+  for (const auto& host : window) {
+    if (host->points.empty()) continue;
+    if (host.get() == &newest) {
+      for (const ActivePoint& p : host->points) ref.points.push_back({Vec2(p.u, p.v), p.idepth, 1.0});
+      continue;
+    }
+    const Eigen::Index np = static_cast<Eigen::Index>(host->points.size());
+    Eigen::Matrix3Xd b(3, np);
+    Eigen::VectorXd vh(np), rho(np);
+    for (Eigen::Index i = 0; i < np; ++i) {
+      const ActivePoint& p = host->points[static_cast<size_t>(i)];
+      b.col(i) = p.bearing;
+      vh[i] = p.v;
+      rho[i] = p.idepth;
+    }
+    projectRollingShutter(*camera, timing, rsFrame(*host, rolling), target, b, vh, rho, proj, popt);
+    for (Eigen::Index i = 0; i < np; ++i) {
+      const RsHostProjection& pr = proj[static_cast<size_t>(i)];
+      if (!pr.valid || !camera->inImage(pr.uv, 2.0)) continue;
+      const ActivePoint& p = host->points[static_cast<size_t>(i)];
+      const Vec3 X = worldPoint(*host, p.bearing, p.v, p.idepth, timing, rolling);
+      const Vec3 P = SE3d::exp(target.xi * pr.t_s) * (target.T_c_w0 * X);
+      const double d = P.norm();
+      if (!(d > 0)) continue;
+      ref.points.push_back({pr.uv, 1.0 / d, 1.0});
+    }
+  }
+  tracker->setReference(ref);
+  first_rmse = std::nan("");
+}
+
+void Odometry::Impl::removeOutliersAndMarginalizePoints(Keyframe& newest) {
+  std::vector<ActivePoint*> to_marg;
+  std::vector<std::pair<Keyframe*, int64_t>> to_drop;
+  const size_t min_good = static_cast<size_t>(bo.min_good_residuals);
+  for (auto& host : window) {
+    for (ActivePoint& p : host->points) {
+      bool newest_oob = false;
+      for (const ActiveObservation& o : p.obs)
+        if (o.target == &newest && o.state == ObsState::kOob) newest_oob = true;
+      p.obs.erase(std::remove_if(p.obs.begin(), p.obs.end(),
+                                 [](const ActiveObservation& o) { return o.state != ObsState::kIn; }),
+                  p.obs.end());
+      if (p.obs.empty() || !(p.idepth > 1e-5) || !std::isfinite(p.idepth)) {
+        p.idepth = -1.0;  // marks the drop
+        continue;
+      }
+      size_t vis_in_marg = 0;
+      for (const ActiveObservation& o : p.obs) vis_in_marg += o.target->flagged_for_marg;
+      const bool oob = newest_oob || (p.obs.size() >= min_good && p.obs.size() - vis_in_marg < min_good);
+      if (!host->flagged_for_marg && !oob) continue;
+      if (p.obs.size() >= min_good && p.idepth_hessian > bo.min_idepth_hessian_marg) {
+        to_marg.push_back(&p);
+      } else {
+        p.idepth = -1.0;
+      }
+    }
+  }
+  if (!to_marg.empty()) {
+    std::vector<int> blocks;
+    Eigen::MatrixXd H;
+    Eigen::VectorXd b;
+    ba->pointsTerm(window, to_marg, bo.marg_weight_factor, &blocks, &H, &b);
+    if (!blocks.empty()) {
+      std::vector<Keyframe*> kfs;
+      for (int k : blocks) kfs.push_back(window[static_cast<size_t>(k)].get());
+      prior->addTerm(kfs, H, b);
+    }
+    for (ActivePoint* p : to_marg) {
+      for (const ActiveObservation& o : p->obs)
+        if (o.state == ObsState::kIn) logObservation(*p, o);
+      recordPoint(*p);
+      p->idepth = -1.0;
+    }
+  }
+  for (auto& host : window) {
+    auto& P = host->points;
+    const size_t before = P.size();
+    P.erase(std::remove_if(P.begin(), P.end(), [](const ActivePoint& p) { return p.idepth < 0.0; }), P.end());
+    host->points_out += static_cast<int>(before - P.size());
+  }
+}
+
+void Odometry::Impl::marginalizeKeyframe(Keyframe* kf) {
+  for (auto& host : window) {
+    if (host.get() == kf) continue;
+    for (ActivePoint& p : host->points) {
+      auto it = std::find_if(p.obs.begin(), p.obs.end(), [&](const ActiveObservation& o) { return o.target == kf; });
+      if (it == p.obs.end()) continue;
+      if (it->state == ObsState::kIn) logObservation(p, *it);
+      p.obs.erase(it);
+    }
+  }
+  kf->points_out += static_cast<int>(kf->points.size());
+  kf->points.clear();
+  kf->candidates.clear();
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  ba->keyframePriorTerm(*kf, &H, &b);
+  if (H.cwiseAbs().maxCoeff() > 0.0) prior->addTerm({kf}, H, b);
+  prior->marginalizeKeyframe(kf);
+  observedTwist(*kf);
+  recordKeyframe(*kf);
+  window.erase(std::remove_if(window.begin(), window.end(), [&](const std::unique_ptr<Keyframe>& k) { return k.get() == kf; }),
+               window.end());
+  reindex(window);
+}
+
+void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms,
+                                  std::shared_ptr<const ImagePyramid> pyr, const SE3d& T_c_w,
+                                  const AffineBrightness& affine) {
+  std::vector<Keyframe*> flagged;
+  if (!window.empty()) flagged = keyframesToMarginalize(window, bo, first_kf_id);
+  auto kf = std::make_unique<Keyframe>();
+  kf->frame_index = frame_index;
+  kf->t_ns = t_ns;
+  kf->kf_id = next_kf_id++;
+  kf->exposure_ms = exposure_ms;
+  kf->pyramid = std::move(pyr);
+  kf->state.T_c_w = T_c_w;
+  kf->state.affine = affine;
+  if (rolling) {
+    kf->state.twist = velocityEstimate();
+    kf->twist_start = kf->state.twist;
+    MotionState ms;
+    ms.t_ns = t_ns;
+    ms.T_c_w = T_c_w;
+    ms.twist = kf->state.twist;
+    ms.is_keyframe = true;
+    for (const auto& m : motion) {
+      TwistPrior tp;
+      if (m->twistPrior(history, ms, &tp)) {
+        kf->has_twist_prior = true;
+        kf->twist_prior = tp;
+        break;
+      }
+    }
+  }
+  if (window.empty()) {
+    kf->gauge = true;
+    first_kf_id = kf->kf_id;
+  }
+  Keyframe* nk = kf.get();
+  window.push_back(std::move(kf));
+  reindex(window);
+  for (auto& h : window)
+    if (h.get() != nk)
+      for (ActivePoint& p : h->points) p.obs.push_back(ActiveObservation{nk});
+  {
+    ScopedStage st(stages, "activate");
+    activateCandidates(*nk);
+  }
+  {
+    ScopedStage st(stages, "optimise");
+    last_ba = ba->optimize(window, *prior, bo.max_iterations);
+  }
+  for (auto& k : window) recordKeyframe(*k);
+  for (auto it = frames.rbegin(); it != frames.rend(); ++it)
+    if (it->index == frame_index) {
+      it->keyframe = true;
+      it->tracked = true;
+      it->ref_kf_id = nk->kf_id;
+      it->T_f_ref = SE3d();
+      it->T_c_w = nk->state.T_c_w;
+      it->affine = nk->state.affine;
+      break;
+    }
+  for (MotionState& s : history)
+    if (s.t_ns == t_ns) {
+      s.T_c_w = nk->state.T_c_w;
+      s.is_keyframe = true;
+    }
+  setTrackingReference(*nk);
+  {
+    ScopedStage st(stages, "marginalise");
+    removeOutliersAndMarginalizePoints(*nk);
+  }
+  createCandidates(*nk);
+  {
+    ScopedStage st(stages, "marginalise");
+    for (Keyframe* f : flagged) marginalizeKeyframe(f);
+  }
+  checkDivergence();
+}
+
+void Odometry::Impl::checkDivergence() {
+  if (failed || window.size() < 2) return;
+  const BundleAdjustmentStats& s = last_ba;
+  const Keyframe& nk = *window.back();
+  std::ostringstream where;
+  where << " after the keyframe at frame " << nk.frame_index << " (t " << io::formatSeconds(nk.t_ns) << " s)";
+  for (const auto& kf : window)
+    if (!kf->state.T_c_w.translation().allFinite() || !kf->state.T_c_w.unit_quaternion().coeffs().allFinite()) {
+      fail("non-finite keyframe state" + where.str());
+      return;
+    }
+  if (s.solver_failed) warnings.push_back("solver: " + s.message + where.str());
+  std::ostringstream os;
+  if (s.num_in > 0 && s.rmse() > bo.fail_max_rmse) {
+    os << "exploding energy: photometric RMSE " << s.rmse() << " > " << bo.fail_max_rmse << where.str();
+  } else if (s.num_obs >= 50 && s.inlierRatio() < bo.fail_min_inlier_ratio) {
+    os << "too few inliers: " << s.num_in << " of " << s.num_obs << " observations (" << s.inlierRatio() << " < "
+       << bo.fail_min_inlier_ratio << ")" << where.str();
+  } else if (numActivePoints() < bo.fail_min_points) {
+    os << "too few points: " << numActivePoints() << " active points < " << bo.fail_min_points << where.str();
+  } else {
+    const double med = medianIdepth();
+    if (initial_median_idepth <= 0.0) {
+      initial_median_idepth = med;
+    } else if (med > 0.0) {
+      const double ratio = med / initial_median_idepth;
+      if (ratio > bo.fail_max_scale_change || ratio < 1.0 / bo.fail_max_scale_change)
+        os << "scale collapse: the median inverse depth changed by a factor " << ratio << " since initialisation"
+           << where.str();
+    }
+  }
+  if (!os.str().empty()) fail(os.str());
+}
+
+}  // namespace rsvio

