@@ -178,6 +178,7 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
   const float cut = static_cast<float>(cutoff);
   const float sat_energy_unit = huberEnergy(cut, kernel.huber);
   const float warp[4] = {1.f, 0.f, 0.f, 1.f};
+  const double explained2 = options_.explained_residual * options_.explained_residual;
 
   auto runBlock = [&](int bi) {
     Block& B = L.blocks[static_cast<size_t>(bi)];
@@ -199,6 +200,18 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
       // Per-point sums of the 8 pattern pixels, then one D^T G D (DSO's factorisation).
       double gxx = 0, gxy = 0, gyy = 0, grx = 0, gry = 0, gcx = 0, gcy = 0, g1x = 0, g1y = 0;
       double cc = 0, c1 = 0, w1 = 0, cr = 0, r1 = 0;
+      if (!linearize) {
+        // Explained point (contract): residual energy below explained_residual^2 x the spread of the
+        // target's pattern intensities I_k = r_k + alpha c_k + beta about their mean.
+        double si = 0, si2 = 0, sr2 = 0;
+        for (int k = 0; k < kPatternSize; ++k) {
+          const double r = res.r[k], I = r + alpha * host.color[k] + beta;
+          si += I;
+          si2 += I * I;
+          sr2 += r * r;
+        }
+        if (sr2 < explained2 * (si2 - si * si / kPatternSize)) ++acc.num_explained;
+      }
       for (int k = 0; k < kPatternSize; ++k) {
         ++acc.num_terms;
         const float r = res.r[k];
@@ -285,6 +298,7 @@ FrameTracker::LevelEnergy FrameTracker::levelEnergy(const ImagePyramid& frame, c
   e.num_terms = lin.num_terms;
   e.num_saturated = lin.num_saturated;
   e.num_points = lin.num_points;
+  e.num_explained = lin.num_explained;
   return e;
 }
 

@@ -29,12 +29,13 @@ struct FrameTracker::Linearization {
   int num_terms = 0;
   int num_saturated = 0;
   int num_points = 0;
+  int num_explained = 0;  // only counted by residual passes (linearize = false): the lost test
 
   void setZero() {
     H.setZero();
     b.setZero();
     energy = 0.0;
-    num_terms = num_saturated = num_points = 0;
+    num_terms = num_saturated = num_points = num_explained = 0;
   }
   void add(const Linearization& o) {
     H += o.H;
@@ -43,6 +44,7 @@ struct FrameTracker::Linearization {
     num_terms += o.num_terms;
     num_saturated += o.num_saturated;
     num_points += o.num_points;
+    num_explained += o.num_explained;
   }
   double meanEnergy() const { return num_terms > 0 ? energy / num_terms : std::nan(""); }
   double saturatedRatio() const { return num_terms > 0 ? static_cast<double>(num_saturated) / num_terms : 1.0; }

@@ -159,6 +159,7 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
   res.rmse = e.rmse();
   res.num_points = e.num_points;
   res.inlier_ratio = e.num_terms > 0 ? 1.0 - static_cast<double>(e.num_saturated) / e.num_terms : 0.0;
+  res.explained_ratio = e.num_points > 0 ? static_cast<double>(e.num_explained) / e.num_points : 0.0;
   const double log_alpha = std::log(exposureRatio(ref_.exposure_ms, info.exposure_ms)) + best.affine.a - ref_.affine.a;
   res.status = TrackResult::Status::Lost;
   if (e.num_points < options_.min_points) {
@@ -169,6 +170,10 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
                  " (rmse " + fmt(res.rmse) + ")";
   } else if (!(res.rmse <= options_.max_rmse)) {
     res.reason = "rmse " + fmt(res.rmse) + " above " + fmt(options_.max_rmse);
+  } else if (!(res.explained_ratio >= options_.min_explained_ratio)) {
+    res.reason = "explained ratio " + fmt(res.explained_ratio) + " below " + fmt(options_.min_explained_ratio) +
+                 " (points in view whose residual RMS is below " + fmt(options_.explained_residual) +
+                 " x their pattern's intensity spread)";
   } else if ((options_.estimate_a && std::abs(log_alpha) > options_.max_abs_log_alpha) ||
              (options_.estimate_b && std::abs(best.affine.b) > options_.max_abs_b)) {
     res.reason = "brightness change out of range (log gain " + fmt(log_alpha) + ", b " + fmt(best.affine.b) + ")";
@@ -221,6 +226,9 @@ ParamTable TrackerOptions::paramTable() {
       paramDouble("track_min_inlier_ratio", d.min_inlier_ratio, 0.0, 1.0, "",
                   "lower share of pattern pixels below the cutoff: tracking lost"),
       paramDouble("track_max_rmse", d.max_rmse, 0.1, 1000.0, "intensity", "higher level-0 RMSE: tracking lost"),
+      paramDouble("track_min_explained_ratio", d.min_explained_ratio, 0.0, 1.0, "",
+                  "lower share of the points in view whose residual RMS is below half their pattern's "
+                  "intensity spread: tracking lost"),
   };
 }
 
@@ -233,6 +241,7 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.min_points = static_cast<int>(p.getInt("track_min_points"));
   o.min_inlier_ratio = p.getDouble("track_min_inlier_ratio");
   o.max_rmse = p.getDouble("track_max_rmse");
+  o.min_explained_ratio = p.getDouble("track_min_explained_ratio");
   return o;
 }
 

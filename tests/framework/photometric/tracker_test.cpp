@@ -82,6 +82,9 @@ TEST(FrameTracker, ConvergesWithinTheStatedBasin) {
     d << dt.normalized() * 0.15, dr.normalized() * 0.05;
     const SE3d guess = SE3d::exp(d) * f.T_new;
     const TrackResult r = tracker.track(*f.new_pyr, TrackingFrame(), {guess});
+    if (getenv("FE_VERBOSE"))
+      printf("basin trial %d: terr %.4f rerr %.4f rmse %.2f inl %.2f expl %.2f\n", trial, transErr(r.T_c_w, f.T_new),
+             rotErr(r.T_c_w, f.T_new), r.rmse, r.inlier_ratio, r.explained_ratio);
     ASSERT_TRUE(r.ok()) << "trial " << trial << ": " << r.reason;
     EXPECT_LT(transErr(r.T_c_w, f.T_new), 0.005) << "trial " << trial;
     EXPECT_LT(rotErr(r.T_c_w, f.T_new), 0.002) << "trial " << trial;
@@ -104,6 +107,10 @@ TEST(FrameTracker, ReportsLostOutsideTheBasinRatherThanAWrongPose) {
     Vec6 d;
     d << dt.normalized() * 0.3, dr.normalized() * 0.5;
     const TrackResult r = tracker.track(*f.new_pyr, TrackingFrame(), {SE3d::exp(d) * f.T_new});
+    if (getenv("FE_VERBOSE"))
+      printf("lost test trial %d: %s terr %.3f rerr %.3f rmse %.2f inl %.2f expl %.2f (%s)\n", trial,
+             r.ok() ? "ok" : "lost", transErr(r.T_c_w, f.T_new), rotErr(r.T_c_w, f.T_new), r.rmse, r.inlier_ratio,
+             r.explained_ratio, r.reason.c_str());
     if (r.ok()) {
       // Allowed only if it truly found the pose.
       EXPECT_LT(transErr(r.T_c_w, f.T_new), 0.01) << "wrong pose reported as tracked, trial " << trial;
@@ -114,6 +121,27 @@ TEST(FrameTracker, ReportsLostOutsideTheBasinRatherThanAWrongPose) {
     }
   }
   EXPECT_GE(lost, 3);
+}
+
+TEST(FrameTracker, TracksWithAThirdOfTheImageOccluded) {
+  // The lost tests must tolerate occlusions: a block of 30 % of the new image shows another part of
+  // the scene (its residuals are large), the rest still determines the pose.
+  const Fixture& f = fixture();
+  FrameTracker tracker(TrackerOptions(), f.camera, RowTiming::global(f.K.height * 0.5 - 0.5));
+  tracker.setReference(f.ref);
+  cv::Mat img = f.scene.render(f.K, test::toPoseCW(f.T_new));
+  const cv::Mat other = f.scene.render(f.K, test::toPoseCW(SE3d::exp(twist(0.5, 0.2, 0.3, 0.3, 0.5, 0.1)) * f.T_new));
+  const int w = static_cast<int>(img.cols * std::sqrt(0.3)), h = static_cast<int>(img.rows * std::sqrt(0.3));
+  other(cv::Rect(0, img.rows - h, w, h)).copyTo(img(cv::Rect(img.cols - w, 0, w, h)));
+  const ImagePyramid pyr(img, 5);
+  const SE3d guess = SE3d::exp(twist(0.04, -0.02, 0.03, 0.01, 0.015, -0.01)) * f.T_new;
+  const TrackResult r = tracker.track(pyr, TrackingFrame(), {guess});
+  if (getenv("FE_VERBOSE"))
+    printf("occluded: terr %.4f rerr %.4f rmse %.2f inl %.2f expl %.2f (%s)\n", transErr(r.T_c_w, f.T_new),
+           rotErr(r.T_c_w, f.T_new), r.rmse, r.inlier_ratio, r.explained_ratio, r.reason.c_str());
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_LT(transErr(r.T_c_w, f.T_new), 0.005);
+  EXPECT_LT(rotErr(r.T_c_w, f.T_new), 0.002);
 }
 
 TEST(FrameTracker, RecoveryGuessesRescueABadFirstGuess) {
