@@ -8,6 +8,7 @@
 #include "rsvio/config/config.h"
 #include "rsvio/config/validate.h"
 #include "rsvio/core/error.h"
+#include "rsvio/core/time.h"
 #include "rsvio/eval/eval_output.h"
 #include "rsvio/eval/evaluate_files.h"
 #include "rsvio/interfaces/data_source.h"
