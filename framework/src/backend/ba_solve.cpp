@@ -176,6 +176,31 @@ bool solveFull(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdju
   return true;
 }
 
+// Removes the monocular scale direction from a camera step and re-derives the point steps from it
+// (DSO's SOLVER_ORTHOGONALIZE_X). Scaling the world by s about its origin maps a keyframe's translation
+// t to s t, its twist's linear part v to s v and every inverse depth rho to rho / s; the photometric
+// energy is invariant, so the direction n (d/ds at s = 1: t, v in the left-perturbation coordinates,
+// -rho) is a null direction of H. Gradient steps have no component along it, but the damping
+// (H + lambda diag H) does give them one: without this projection the scale random-walks by a few
+// per cent per keyframe.
+void removeScaleDirection(const BundleAdjuster::Impl& m, const Linearization& L, const BundleAdjustmentConfig& cfg,
+                          double lambda, Eigen::VectorXd& dx_c, Eigen::VectorXd& dx_p) {
+  const int kd = cfg.layout.kfDim();
+  std::vector<double> keep(static_cast<size_t>(m.nc), 1.0);
+  for (int i = 0; i < m.nc; ++i)
+    if (m.fixed[static_cast<size_t>(i)] || !(L.Hcc(i, i) > kMinDiag)) keep[static_cast<size_t>(i)] = 0.0;
+  Eigen::VectorXd n = Eigen::VectorXd::Zero(m.nc);
+  for (const auto& kf : *m.window) {
+    n.segment<3>(kf->index * kd + StateLayout::kPose) = kf->state.T_c_w.translation();
+    if (cfg.layout.rolling) n.segment<3>(kf->index * kd + StateLayout::kTwist) = kf->state.twist.head<3>();
+  }
+  for (int i = 0; i < m.nc; ++i) n[i] *= keep[static_cast<size_t>(i)];
+  const double nn = n.squaredNorm();
+  if (!(nn > 0.0)) return;
+  dx_c -= n * (n.dot(dx_c) / nn);
+  backSubstitute(m, L, lambda, kd, keep, dx_c, dx_p);
+}
+
 // Writes the observation states and diagnostics of a linearisation back to the window.
 void writeBack(BundleAdjuster::Impl& m, const Linearization& L) {
   for (size_t r = 0; r < m.obs_refs.size(); ++r) {
@@ -276,6 +301,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       }
       continue;
     }
+    if (config_.fix_scale_gauge) ba::removeScaleDirection(m, m.cur, config_, lambda, dx_c, dx_p);
     for (auto& kf : window) {
       kf->backup = kf->state;
       applyStep(kf->state, dx_c.segment(kf->index * kd, kd), config_.layout);

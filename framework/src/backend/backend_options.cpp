@@ -45,6 +45,9 @@ ParamTable backendParamTable() {
                "Gauss-Newton iterations on a candidate's inverse depth against the window before activation"),
       paramDouble("activation_min_dist_px", d.activation_min_dist_px, 0.0, 4.0, "px",
                   "initial distance between active points on pyramid level 1; adapted towards active_points"),
+      paramDouble("activation_min_idepth_hessian", d.activation_min_idepth_hessian, 0.0, 1e9, "",
+                  "information on a candidate's inverse depth after its activation steps below which it is dropped "
+                  "(DSO setting_minIdepthH_act)"),
       paramInt("init_min_frames", d.init_min_frames, 1, 1000, "", "frames after the first before initialising"),
       paramInt("init_max_frames", d.init_max_frames, 2, 100000, "",
                "frames without a successful monocular initialisation before the run fails"),
@@ -90,6 +93,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.max_log_affine = p.getDouble("max_log_affine");
   o.activation_iterations = static_cast<int>(p.getInt("activation_iterations"));
   o.activation_min_dist_px = p.getDouble("activation_min_dist_px");
+  o.activation_min_idepth_hessian = p.getDouble("activation_min_idepth_hessian");
   o.init_min_frames = static_cast<int>(p.getInt("init_min_frames"));
   o.init_max_frames = static_cast<int>(p.getInt("init_max_frames"));
   o.init_min_flow_px = p.getDouble("init_min_flow_px");

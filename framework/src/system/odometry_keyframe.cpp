@@ -184,11 +184,13 @@ void Odometry::Impl::activateCandidates(Keyframe& newest) {
   std::vector<ActivePoint*> ptrs;
   for (const auto& [h, i] : new_points) ptrs.push_back(&h->points[i]);
   ba->optimizeDepths(window, ptrs, bo.activation_iterations);
-  // Keep the observations that fit; drop points that fit nowhere (DSO: at least one good residual).
+  // Keep the observations that fit; drop points that fit nowhere (DSO: at least one good residual) and
+  // points whose depth the window hardly constrains (DSO's minimum inverse-depth information).
   for (ActivePoint* p : ptrs) {
     p->obs.erase(std::remove_if(p->obs.begin(), p->obs.end(),
                                 [](const ActiveObservation& o) { return o.state != ObsState::kIn; }),
                  p->obs.end());
+    if (!(p->idepth_hessian >= bo.activation_min_idepth_hessian)) p->obs.clear();
   }
   for (auto& host : window) {
     auto& P = host->points;

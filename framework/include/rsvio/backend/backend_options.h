@@ -41,6 +41,7 @@ struct BackendOptions {
   // Candidate activation (which candidates are ready: the front end's trace_* options).
   int activation_iterations = 3;            // GN iterations on a candidate's inverse depth (DSO: 3)
   double activation_min_dist_px = 2.0;      // initial distance between active points, level-1 px (DSO: 2)
+  double activation_min_idepth_hessian = 100.0;  // dropped below this after activation (DSO setting_minIdepthH_act)
   // Monocular initialisation (runs without an IMU).
   int init_min_frames = 3;            // frames after the first before an attempt
   int init_max_frames = 60;           // give up (status failed) after this many frames

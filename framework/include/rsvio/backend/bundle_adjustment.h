@@ -24,8 +24,8 @@
 //   re-solved from the kept linearisation). A step is accepted when the total energy decreases.
 // - Fixed dimensions (the gauge keyframe's pose and a, b; a, b of every keyframe when affine
 //   brightness is not estimated) get zero rows and a unit diagonal: their step is 0.
-// - Gauge: pose and a, b of a keyframe with Keyframe::gauge are fixed; scale (monocular) is left to
-//   the damping and, after the first marginalisation, to the prior.
+// - Gauge: pose and a, b of a keyframe with Keyframe::gauge are fixed; the monocular scale is a null
+//   direction that every step is projected off (fix_scale_gauge), so the steps never change it.
 // - Determinism and threads: residuals are evaluated per host-target pair and accumulated per block
 //   of points into their own partial sums, added in block order: the result is identical for 1 and 2
 //   threads. No allocation per residual; buffers are reused across iterations.
@@ -65,6 +65,10 @@ struct BundleAdjustmentConfig {
   double lambda_initial = 1e-4;
   double step_threshold = 1e-4;    // relative energy decrease that ends the iterations
   double twist_regularization = 1e-6;
+  // Monocular runs: remove the scale direction (a null direction of the photometric energy) from every
+  // step, so the damping cannot move the scale (DSO orthogonalises its steps the same way). Off when
+  // a term makes the scale observable (IMU).
+  bool fix_scale_gauge = true;
   int threads = 1;                 // 1 or 2
 };
 
