@@ -3,6 +3,8 @@
 //   2. run the global-shutter model configs/gs_vo.json on it, evaluated against the ground truth,
 //   3. render the run's figures and index.html,
 //   4. print what it assembled, the figures and the paths of the outputs.
+// Exit 0 once the run has written its report, even when the model failed on the sequence (that is
+// what the demo shows); non-zero when a step could not be done (simulation, config, output folder).
 // The diagnosis loop (diagnose, switch the named plugin on, run again, compare) joins when
 // `rsvio diagnose` lands; until then the demo says so instead of pretending.
 #include <chrono>
@@ -79,13 +81,19 @@ int runDemo(const std::string& out, const GlobalOptions& g) {
   const Report& rep = res.report;
   std::printf("\nresult: %s, %ld frames, %ld keyframes, %.1f fps (realtime factor %.2f)\n", rep.status.c_str(),
               rep.frames, rep.keyframes, rep.fps, rep.realtime_factor);
-  if (!rep.ok()) std::printf("  failure: %s\n", rep.error.c_str());
+  if (!rep.ok()) {
+    std::printf("  failure: %s\n", rep.error.c_str());
+    std::printf("  (expected on this sequence: its camera has a ~30 ms rolling-shutter readout that the global-shutter\n"
+                "   model does not know; on its global-shutter twin, --set effects.rolling_shutter=null, gs_vo tracks)\n");
+  }
   if (rep.eval) std::printf("  ATE (keyframes, %s): %.4f m\n", rep.eval->align.c_str(), rep.eval->ate_rmse_m);
   for (const auto& [stage, ms] : rep.stage_ms) std::printf("  %-20s %.2f ms\n", stage.c_str(), ms);
   std::printf("outputs: %s (trajectory.tum, keyframes.tum, points.ply, states.csv, report.json)\n", run_dir.c_str());
   std::printf("figures: %s\n", (fs::path(run_dir) / "index.html").string().c_str());
   std::printf("next: the diagnosis loop (rsvio diagnose --run %s) is not available yet\n", run_dir.c_str());
-  return rep.ok() ? 0 : 1;
+  // The demo's job is done when the run produced its report, whatever the model made of the sequence:
+  // a global-shutter model failing on a hidden rolling shutter is the demo's finding, not its error.
+  return 0;
 }
 
 }  // namespace

@@ -156,7 +156,8 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   for (const auto& w : odo.warnings()) report.warnings.push_back(w);
 
   writeOutputs(odo, request.out_dir, cfg, report.warnings);
-  if (cfg["output"]["evaluate"].get<bool>() && report.ok()) evaluate(request.data_dir, request.out_dir, report);
+  // A failed run is evaluated too: what it estimated before the failure is worth a figure.
+  if (cfg["output"]["evaluate"].get<bool>()) evaluate(request.data_dir, request.out_dir, report);
   report.write((fs::path(request.out_dir) / "report.json").string());
   return result;
 }
