@@ -21,6 +21,9 @@ ParamTable backendParamTable() {
                   "stop iterating when the relative energy decrease is below this"),
       paramDouble("marg_weight_factor", d.marg_weight_factor, 0.0, 1.0, "",
                   "factor on the information of marginalised points (DSO: 0.25)"),
+      paramBool("marg_project_scale", d.marg_project_scale,
+                "project the monocular scale direction at the prior's linearisation points off the terms of "
+                "marginalised points, so the prior keeps it as a null direction (FEJ consistency; docs/backend.md)"),
       paramDouble("min_idepth_hessian_marg", d.min_idepth_hessian_marg, 0.0, 1e12, "1/idepth^2",
                   "inverse-depth information a leaving point needs to enter the prior (DSO: 50)"),
       paramInt("min_good_residuals", d.min_good_residuals, 1, 64, "",
@@ -80,6 +83,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.lambda_initial = p.getDouble("lambda_initial");
   o.step_threshold = p.getDouble("step_threshold");
   o.marg_weight_factor = p.getDouble("marg_weight_factor");
+  o.marg_project_scale = p.getBool("marg_project_scale");
   o.min_idepth_hessian_marg = p.getDouble("min_idepth_hessian_marg");
   o.min_good_residuals = static_cast<int>(p.getInt("min_good_residuals"));
   o.gauge_information = p.getDouble("gauge_information");

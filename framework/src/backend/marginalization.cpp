@@ -57,6 +57,27 @@ void MarginalizationPrior::addTerm(const std::vector<Keyframe*>& kfs, const Eige
   }
 }
 
+void MarginalizationPrior::addScaleFreeTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t,
+                                            const Eigen::VectorXd& b_t, bool project_scale) {
+  const int d = layout_.kfDim();
+  if (!project_scale || H_t.rows() != static_cast<Eigen::Index>(kfs.size()) * d) return addTerm(kfs, H_t, b_t);
+  for (Keyframe* kf : kfs) addKeyframe(kf);  // freezes x_lin of keyframes new to the prior
+  Eigen::VectorXd n = Eigen::VectorXd::Zero(H_t.rows());
+  for (size_t i = 0; i < kfs.size(); ++i) {
+    const Eigen::Index o = static_cast<Eigen::Index>(i) * d;
+    n.segment<3>(o + StateLayout::kPose) = kfs[i]->lin.T_c_w.translation();
+    if (layout_.rolling) n.segment<3>(o + StateLayout::kTwist) = kfs[i]->lin.twist.head<3>();
+  }
+  const double nn = n.squaredNorm();
+  if (!(nn > 0.0)) return addTerm(kfs, H_t, b_t);
+  const Eigen::VectorXd u = n / std::sqrt(nn);
+  const Eigen::VectorXd Hu = H_t * u;
+  const double uHu = u.dot(Hu);
+  const Eigen::MatrixXd H_p = H_t - u * Hu.transpose() - Hu * u.transpose() + uHu * (u * u.transpose());
+  const Eigen::VectorXd b_p = b_t - u * u.dot(b_t);
+  addTerm(kfs, H_p, b_p);
+}
+
 void MarginalizationPrior::marginalizeKeyframe(Keyframe* kf) {
   const int k = blockOf(kf);
   if (k < 0) return;

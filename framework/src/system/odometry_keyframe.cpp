@@ -278,7 +278,7 @@ void Odometry::Impl::removeOutliersAndMarginalizePoints(Keyframe& newest) {
     if (!blocks.empty()) {
       std::vector<Keyframe*> kfs;
       for (int k : blocks) kfs.push_back(window[static_cast<size_t>(k)].get());
-      prior->addTerm(kfs, H, b);
+      prior->addScaleFreeTerm(kfs, H, b, bo.marg_project_scale);
     }
     for (ActivePoint* p : to_marg) {
       for (const ActiveObservation& o : p->obs)

@@ -143,5 +143,64 @@ TEST(Marginalization, LinearisationPointIsFrozenAndTheModelIsQuadraticAroundIt) 
   EXPECT_NEAR(prior.energy(), energyAt(Eigen::VectorXd::Zero(2 * d)), 1e-9 * (1.0 + std::abs(prior.energy())));
 }
 
+TEST(Marginalization, ScaleFreeTermKeepsTheScaleAtTheLinearisationPointsNull) {
+  // A term linearised away from x_lin (here: at states scaled by 1.05 and rotated) is not
+  // scale-invariant at x_lin; addScaleFreeTerm projects the scale direction at x_lin off it, so the
+  // prior stays without information on the monocular scale; without the projection it has some (the
+  // window also rotated by 0.05 rad, which turns the direction of the stacked translations).
+  StateLayout layout;
+  const int d = layout.kfDim();
+  Keyframe a, b, c;
+  a.state.T_c_w = SE3d::exp(tw(0.4, 0.2, -0.1, 0.05, 0.02, -0.03));
+  b.state.T_c_w = SE3d::exp(tw(-0.3, 0.5, 0.2, -0.02, 0.04, 0.01));
+  c.state.T_c_w = SE3d::exp(tw(0.1, -0.6, 0.7, 0.01, -0.05, 0.02));
+  std::vector<Keyframe*> kfs{&a, &b, &c};
+  for (int i = 0; i < 3; ++i) kfs[static_cast<size_t>(i)]->index = i;
+  auto scaleDir = [&](bool lin) {
+    Eigen::VectorXd n = Eigen::VectorXd::Zero(3 * d);
+    for (int i = 0; i < 3; ++i) {
+      const Keyframe& k = *kfs[static_cast<size_t>(i)];
+      n.segment<3>(i * d + StateLayout::kPose) = (lin ? k.lin : k.state).T_c_w.translation();
+    }
+    return Eigen::VectorXd(n.normalized());
+  };
+  std::mt19937 rng(7);
+  std::normal_distribution<double> nd(0, 1);
+  auto randomTerm = [&](Eigen::MatrixXd* H, Eigen::VectorXd* g) {
+    Eigen::MatrixXd J(4 * d, 3 * d);
+    for (int i = 0; i < J.rows(); ++i)
+      for (int j = 0; j < J.cols(); ++j) J(i, j) = nd(rng);
+    const Eigen::VectorXd u = scaleDir(false);  // null at the CURRENT states, as a points term is
+    J -= (J * u) * u.transpose();
+    *H = J.transpose() * J;
+    g->resize(3 * d);
+    for (int i = 0; i < g->size(); ++i) (*g)[i] = nd(rng);
+    *g -= u * u.dot(*g);
+  };
+  for (bool project : {false, true}) {
+    MarginalizationPrior prior(layout);
+    for (Keyframe* k : kfs) k->in_prior = false;
+    a.state.T_c_w = SE3d::exp(tw(0.4, 0.2, -0.1, 0.05, 0.02, -0.03));
+    b.state.T_c_w = SE3d::exp(tw(-0.3, 0.5, 0.2, -0.02, 0.04, 0.01));
+    c.state.T_c_w = SE3d::exp(tw(0.1, -0.6, 0.7, 0.01, -0.05, 0.02));
+    Eigen::MatrixXd H;
+    Eigen::VectorXd g;
+    randomTerm(&H, &g);
+    prior.addScaleFreeTerm(kfs, H, g, project);
+    for (Keyframe* k : kfs) k->state.T_c_w.translation() *= 1.05;  // the window's scale moved
+    for (Keyframe* k : kfs) k->state.T_c_w = SE3d::exp(tw(0.0, 0.0, 0.0, 0.05, 0.0, 0.0)) * k->state.T_c_w;
+    randomTerm(&H, &g);
+    prior.addScaleFreeTerm(kfs, H, g, project);
+    const Eigen::VectorXd u = scaleDir(true);
+    const double info = u.dot(prior.H() * u) / prior.H().trace();
+    if (project) {
+      EXPECT_LT(info, 1e-12);
+      EXPECT_LT(std::abs(u.dot(prior.b())), 1e-9 * prior.b().norm());
+    } else {
+      EXPECT_GT(info, 1e-6);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rsvio

@@ -25,6 +25,7 @@ struct BackendOptions {
   double lambda_initial = 1e-4;       // relative diagonal damping, H_ii *= (1 + lambda)
   double step_threshold = 1e-4;       // stop when the relative energy decrease is below this
   double marg_weight_factor = 0.25;   // Hessian factor of marginalised points (DSO setting_margWeightFac)
+  bool marg_project_scale = true;     // project the scale direction at x_lin off marginalised points' terms
   double min_idepth_hessian_marg = 50.0;  // a point leaving the window goes into the prior above this (DSO)
   int min_good_residuals = 3;         // observations a point needs to be kept / marginalised (DSO: 3)
   double gauge_information = 1e12;   // information fixing the first keyframe's pose and affine a, b

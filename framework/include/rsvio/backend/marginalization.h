@@ -44,6 +44,15 @@ class MarginalizationPrior {
   // order); keyframes without a block get one first.
   void addTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t, const Eigen::VectorXd& b_t);
 
+  // The same for a term whose keyframes are the window's only through points that scaled with them
+  // (marginalised points): when project_scale is set, the monocular scale direction at the keyframes'
+  // linearisation points (pose translation t_lin, twist velocity v_lin, the rest zero) is first
+  // projected off H_t and b_t (H_t <- P H_t P, b_t <- P b_t, P = I - u u^T). H_t is linearised at the
+  // current state, so its null direction is the scale at x, not at x_lin; summed with earlier terms it
+  // would give the prior information on the scale, which the photometric energy does not have.
+  void addScaleFreeTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t, const Eigen::VectorXd& b_t,
+                        bool project_scale);
+
   // Removes kf's block by the Schur complement (see the contract).
   void marginalizeKeyframe(Keyframe* kf);
 
