@@ -25,6 +25,23 @@ Vec3 worldPoint(const Keyframe& host, const Vec3& bearing, double v, double idep
   return host.state.T_c_w.inverse() * Z;
 }
 
+// Projects every active point of `host` into `target` (one batch, no Jacobians); proj[i] is points[i]'s.
+void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const Keyframe& host, const RsFrame& target,
+                       bool rolling, std::vector<RsHostProjection>* proj) {
+  const Eigen::Index np = static_cast<Eigen::Index>(host.points.size());
+  Eigen::Matrix3Xd b(3, np);
+  Eigen::VectorXd vh(np), rho(np);
+  for (Eigen::Index i = 0; i < np; ++i) {
+    const ActivePoint& p = host.points[static_cast<size_t>(i)];
+    b.col(i) = p.bearing;
+    vh[i] = p.v;
+    rho[i] = p.idepth;
+  }
+  RsProjectionOptions popt;
+  popt.jacobians = false;
+  projectRollingShutter(camera, timing, rsFrame(host, rolling), target, b, vh, rho, *proj, popt);
+}
+
 }  // namespace
 
 int Odometry::Impl::numActivePoints() const {
@@ -98,16 +115,7 @@ void Odometry::Impl::activateCandidates(Keyframe& newest) {
   int occupied = 0;
   for (auto& host : window) {
     if (host.get() == &newest || host->points.empty()) continue;
-    const Eigen::Index np = static_cast<Eigen::Index>(host->points.size());
-    Eigen::Matrix3Xd b(3, np);
-    Eigen::VectorXd vh(np), rho(np);
-    for (Eigen::Index i = 0; i < np; ++i) {
-      const ActivePoint& p = host->points[static_cast<size_t>(i)];
-      b.col(i) = p.bearing;
-      vh[i] = p.v;
-      rho[i] = p.idepth;
-    }
-    projectRollingShutter(*camera, timing, rsFrame(*host, rolling), target, b, vh, rho, proj, popt);
+    projectHostPoints(*camera, timing, *host, target, rolling, &proj);
     for (const RsHostProjection& pr : proj) {
       int x, y;
       if (pr.valid && toLevel(pr.uv, &x, &y)) {
@@ -208,8 +216,6 @@ void Odometry::Impl::setTrackingReference(const Keyframe& newest) {
   ref.affine = newest.state.affine;
   ref.exposure_ms = newest.exposure_ms;
   ref.pyramid = newest.pyramid;
-  RsProjectionOptions popt;
-  popt.jacobians = false;
   std::vector<RsHostProjection> proj;
   const RsFrame target = rsFrame(newest, rolling);
   for (const auto& host : window) {
@@ -218,20 +224,11 @@ void Odometry::Impl::setTrackingReference(const Keyframe& newest) {
       for (const ActivePoint& p : host->points) ref.points.push_back({Vec2(p.u, p.v), p.idepth, 1.0});
       continue;
     }
-    const Eigen::Index np = static_cast<Eigen::Index>(host->points.size());
-    Eigen::Matrix3Xd b(3, np);
-    Eigen::VectorXd vh(np), rho(np);
-    for (Eigen::Index i = 0; i < np; ++i) {
-      const ActivePoint& p = host->points[static_cast<size_t>(i)];
-      b.col(i) = p.bearing;
-      vh[i] = p.v;
-      rho[i] = p.idepth;
-    }
-    projectRollingShutter(*camera, timing, rsFrame(*host, rolling), target, b, vh, rho, proj, popt);
-    for (Eigen::Index i = 0; i < np; ++i) {
-      const RsHostProjection& pr = proj[static_cast<size_t>(i)];
+    projectHostPoints(*camera, timing, *host, target, rolling, &proj);
+    for (size_t i = 0; i < proj.size(); ++i) {
+      const RsHostProjection& pr = proj[i];
       if (!pr.valid || !camera->inImage(pr.uv, 2.0)) continue;
-      const ActivePoint& p = host->points[static_cast<size_t>(i)];
+      const ActivePoint& p = host->points[i];
       const Vec3 X = worldPoint(*host, p.bearing, p.v, p.idepth, timing, rolling);
       const Vec3 P = SE3d::exp(target.xi * pr.t_s) * (target.T_c_w0 * X);
       const double d = P.norm();
