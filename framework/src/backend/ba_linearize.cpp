@@ -139,18 +139,38 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
     }
     ol.state = ObsState::kIn;
     ol.energy = res.energy;
-    // M = K^T W K, g = K^T W r with K rows (gx, gy, c, alpha, -c, -1), c = alpha (I_host - b_host).
-    ol.M.setZero();
-    ol.g.setZero();
+    // M = K^T W K, g = K^T W r with K rows (gx, gy, c, A, -c, -1), c = A (I_host - b_host), A = alpha:
+    // formed from 14 weighted sums over the pattern (the last three columns repeat the third and a
+    // constant), not from 8 outer products.
     const double hb = pw.host->state.affine.b;
+    const double A = tr.alpha;
+    double s_w = 0, s_c = 0, s_cc = 0, s_x = 0, s_y = 0, s_xx = 0, s_xy = 0, s_yy = 0, s_xc = 0, s_yc = 0;
+    double r_x = 0, r_y = 0, r_c = 0, r_1 = 0;
     for (int i = 0; i < kPatternSize; ++i) {
-      const double c = tr.alpha * (p.pattern.color[i] - hb);
-      Vec6d kr;
-      kr << res.gx[i], res.gy[i], c, tr.alpha, -c, -1.0;
-      const double w = res.w[i];
-      ol.M.noalias() += (w * kr).lazyProduct(kr.transpose());  // 6x6: coefficient-wise, no GEMM set-up
-      ol.g += (w * res.r[i]) * kr;
+      const double c = A * (p.pattern.color[i] - hb);
+      const double w = res.w[i], gx = res.gx[i], gy = res.gy[i], wr = w * res.r[i];
+      s_w += w;
+      s_c += w * c;
+      s_cc += w * c * c;
+      s_x += w * gx;
+      s_y += w * gy;
+      s_xx += w * gx * gx;
+      s_xy += w * gx * gy;
+      s_yy += w * gy * gy;
+      s_xc += w * gx * c;
+      s_yc += w * gy * c;
+      r_x += wr * gx;
+      r_y += wr * gy;
+      r_c += wr * c;
+      r_1 += wr;
     }
+    ol.M << s_xx, s_xy, s_xc, A * s_x, -s_xc, -s_x,
+            s_xy, s_yy, s_yc, A * s_y, -s_yc, -s_y,
+            s_xc, s_yc, s_cc, A * s_c, -s_cc, -s_c,
+            A * s_x, A * s_y, A * s_c, A * A * s_w, -A * s_c, -A * s_w,
+            -s_xc, -s_yc, -s_cc, -A * s_c, s_cc, s_c,
+            -s_x, -s_y, -s_c, -A * s_w, s_c, s_w;
+    ol.g << r_x, r_y, r_c, A * r_1, -r_c, -r_1;
     ol.Jg.block<2, 6>(0, kColHostPose) = pr.d_uv_d_Th0;
     ol.Jg.block<2, 6>(0, kColHostTwist) = pr.d_uv_d_xi_h;
     ol.Jg.block<2, 6>(0, kColTargetPose) = pr.d_uv_d_T0;
@@ -162,9 +182,15 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
 // Accumulates the points of one chunk: their Schur data and the camera blocks.
 template <int KD>
 void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
+  // Per observation, Hl = Jl^T M Jl over the N = 2 KD + 1 coordinates (host block, target block,
+  // inverse depth) is formed compactly: only NG geometric columns (poses, twists when rolling, inverse
+  // depth) carry d uv, and the four affine columns are selectors, so
+  //   H_gg = G^T M_uu G, H_ga = G^T M_ua, H_aa = M_aa   (G: 2 x NG)
+  // and then scattered into Hl (about 5x fewer products than the dense 6 x N form).
   constexpr int N = 2 * KD + 1;
-  using JL = Eigen::Matrix<double, 6, N>;
+  constexpr int NG = KD == 14 ? 25 : 13;
   using HL = Eigen::Matrix<double, N, N>;
+  using GM = Eigen::Matrix<double, 2, NG>;
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
   cs.H.setZero();
   cs.b.setZero();
@@ -173,14 +199,27 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   const int np = static_cast<int>(m.points.size());
   const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
   const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
-  JL Jl = JL::Zero();
-  Jl(2, StateLayout::kAffine) = 1.0;
-  Jl(3, StateLayout::kAffine + 1) = 1.0;
-  Jl(4, KD + StateLayout::kAffine) = 1.0;
-  Jl(5, KD + StateLayout::kAffine + 1) = 1.0;
-  Eigen::Matrix<double, 6, N> MJ;
-  HL Hl;
-  Eigen::Matrix<double, N, 1> bl;
+  // Where the compact columns go in Hl, and where they come from in ObsLin::Jg.
+  int gidx[NG], gsrc[NG];
+  {
+    int k = 0;
+    for (int i = 0; i < 6; ++i, ++k) gidx[k] = StateLayout::kPose + i, gsrc[k] = kColHostPose + i;
+    if constexpr (KD == 14)
+      for (int i = 0; i < 6; ++i, ++k) gidx[k] = StateLayout::kTwist + i, gsrc[k] = kColHostTwist + i;
+    for (int i = 0; i < 6; ++i, ++k) gidx[k] = KD + StateLayout::kPose + i, gsrc[k] = kColTargetPose + i;
+    if constexpr (KD == 14)
+      for (int i = 0; i < 6; ++i, ++k) gidx[k] = KD + StateLayout::kTwist + i, gsrc[k] = kColTargetTwist + i;
+    gidx[k] = 2 * KD, gsrc[k] = kColIdepth;
+  }
+  const int aidx[4] = {StateLayout::kAffine, StateLayout::kAffine + 1, KD + StateLayout::kAffine,
+                       KD + StateLayout::kAffine + 1};
+  GM G;
+  Eigen::Matrix<double, 2, NG> MG;
+  Eigen::Matrix<double, NG, NG> Hgg;
+  Eigen::Matrix<double, NG, 4> Hga;
+  Eigen::Matrix<double, NG, 1> bg;
+  HL Hl = HL::Zero();
+  Eigen::Matrix<double, N, 1> bl = Eigen::Matrix<double, N, 1>::Zero();
   for (int i = begin; i < end; ++i) {
     const ActivePoint& p = *m.points[static_cast<size_t>(i)];
     const int hb = p.host->index;
@@ -199,17 +238,20 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       ++cs.num_in;
       cs.energy_in += ol.energy;
       const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
-      Jl.template block<2, 6>(0, StateLayout::kPose) = ol.Jg.block<2, 6>(0, kColHostPose);
-      Jl.template block<2, 6>(0, KD + StateLayout::kPose) = ol.Jg.block<2, 6>(0, kColTargetPose);
-      if constexpr (KD == 14) {
-        Jl.template block<2, 6>(0, StateLayout::kTwist) = ol.Jg.block<2, 6>(0, kColHostTwist);
-        Jl.template block<2, 6>(0, KD + StateLayout::kTwist) = ol.Jg.block<2, 6>(0, kColTargetTwist);
+      for (int k = 0; k < NG; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
+      MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G);
+      Hgg.noalias() = G.transpose().lazyProduct(MG);
+      Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
+      bg.noalias() = -G.transpose() * ol.g.template head<2>();
+      for (int a = 0; a < NG; ++a) {
+        for (int c = 0; c < NG; ++c) Hl(gidx[a], gidx[c]) = Hgg(a, c);
+        for (int c = 0; c < 4; ++c) Hl(gidx[a], aidx[c]) = Hl(aidx[c], gidx[a]) = Hga(a, c);
+        bl[gidx[a]] = bg[a];
       }
-      Jl.template block<2, 1>(0, 2 * KD) = ol.Jg.col(kColIdepth);
-      // Small fixed sizes: lazyProduct keeps Eigen from its GEMM path (packing costs more than the work).
-      MJ.noalias() = ol.M.lazyProduct(Jl);
-      Hl.noalias() = Jl.transpose().lazyProduct(MJ);
-      bl.noalias() = -Jl.transpose() * ol.g;
+      for (int a = 0; a < 4; ++a) {
+        for (int c = 0; c < 4; ++c) Hl(aidx[a], aidx[c]) = ol.M(2 + a, 2 + c);
+        bl[aidx[a]] = -ol.g[2 + a];
+      }
       Hpp += Hl(2 * KD, 2 * KD);
       bp += bl[2 * KD];
       h_host += Hl.template block<KD, 1>(0, 2 * KD);
