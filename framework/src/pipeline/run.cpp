@@ -1,8 +1,12 @@
+// The run loop behind `rsvio run` and `rsvio demo` (contract in rsvio/pipeline/run.h): validate the
+// config, open the source, feed IMU samples and frames to rsvio::Odometry in time order with progress
+// lines, write the user contract's files (also after a failure) and evaluate against ground truth.
 #include "rsvio/pipeline/run.h"
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 
 #include "rsvio/config/config.h"
