@@ -133,7 +133,14 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
       report.error = e.what();
       break;
     }
-    const FrameStatus st = odo.addFrame(frame);
+    FrameStatus st;
+    try {
+      st = odo.addFrame(frame);  // throws DataError for a frame that does not fit the calibration
+    } catch (const Error& e) {
+      report.status = "failed";
+      report.error = e.what();
+      break;
+    }
     ++processed;
     const bool print_now = request.verbosity >= 2 || (request.verbosity >= 1 && secondsSince(last_print) > 2.0);
     if (print_now || (request.verbosity >= 1 && i + 1 == n)) {
