@@ -195,9 +195,16 @@ void removeScaleDirection(const BundleAdjuster::Impl& m, const Linearization& L,
     if (cfg.layout.rolling) n.segment<3>(kf->index * kd + StateLayout::kTwist) = kf->state.twist.head<3>();
   }
   for (int i = 0; i < m.nc; ++i) n[i] *= keep[static_cast<size_t>(i)];
-  const double nn = n.squaredNorm();
-  if (!(nn > 0.0)) return;
-  dx_c -= n * (n.dot(dx_c) / nn);
+  // Oblique projection: the scale is measured on the translations only (m), the removed component is
+  // along the null direction n. With a rolling shutter the twist velocities are weakly observable;
+  // measuring the scale on them too (orthogonal projection) forces every velocity change into a
+  // compensating scaling of the translations.
+  Eigen::VectorXd mv = n;
+  if (cfg.layout.rolling)
+    for (const auto& kf : *m.window) mv.segment<3>(kf->index * kd + StateLayout::kTwist).setZero();
+  const double mn = mv.dot(n);
+  if (!(mn > 0.0)) return;
+  dx_c -= n * (mv.dot(dx_c) / mn);
   backSubstitute(m, L, lambda, kd, keep, dx_c, dx_p);
 }
 

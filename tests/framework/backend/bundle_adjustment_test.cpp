@@ -114,11 +114,49 @@ TEST(BundleAdjustment, RollingShutterEnergyExplainsRollingShutterImages) {
   EXPECT_GT(t_gs.rmse(), 1.4 * t_rs.rmse());
 }
 
-// KNOWN DEFECT (rolling-shutter issue): from perturbed poses and twists the rolling-shutter window
-// reaches an energy below the truth's but the twists stay about 0.7 m/s off and the centres 6-17 mm
-// off; the same images optimised as global shutter fit about as well. Either the twist is weakly
-// observable in this window or the host-side rolling-shutter Jacobian is off; to be settled with the
-// rolling-shutter model.
+// With a strong twist prior at the truth the rolling-shutter window converges: poses, energy and
+// twists. (Measured: centres 2.6 mm, twists 0.03 m/s / 0.02 rad/s, energy 0.97 x the truth's.) This
+// also guards the scale-gauge projection in rolling mode, which once measured the scale on the twist
+// velocities too and collapsed the translations (scale 0.3) whenever a step changed the velocities.
+TEST(BundleAdjustment, RollingShutterWindowWithATwistPriorConverges) {
+  const double line_delay = 30e-3 / 256;
+  TestWindow w(4, true, line_delay);
+  w.addPoints(0, 400);
+  w.addPoints(2, 300, 9);
+  w.window[0]->gauge = true;
+  auto solver = dense();
+  BundleAdjustmentConfig cfg = gsConfig();
+  cfg.layout.rolling = true;
+  BundleAdjuster ba(cfg, w.camera, w.timing, *solver);
+  MarginalizationPrior prior(cfg.layout);
+  for (auto& kf : w.window) {
+    kf->has_twist_prior = true;
+    kf->twist_prior.mean = w.truth[static_cast<size_t>(kf->index)].twist;
+    kf->twist_prior.information = Mat6::Identity() * 1e4;
+  }
+  const BundleAdjustmentStats truth = ba.evaluate(w.window, prior);
+  for (auto& kf : w.window) kf->state.twist += tw(0.2, -0.1, 0.1, 0.1, 0.1, -0.1);
+  perturb(w, 0.015, 0.008, 0.05, 3);
+  const BundleAdjustmentStats s = ba.optimize(w.window, prior, 30);
+  EXPECT_LT(s.energy_final, 1.01 * truth.energy_final);
+  const double scale = bestScale(w);
+  EXPECT_NEAR(scale, 1.0, 0.05);
+  for (size_t i = 1; i < w.window.size(); ++i) {
+    EXPECT_LT(rotErr(w.window[i]->state.T_c_w, w.truth[i].T_c_w), 1.5e-3) << "keyframe " << i;
+    const Vec3 c = (w.window[i]->state.T_c_w.inverse().translation() - w.window[0]->state.T_c_w.inverse().translation()) * scale;
+    const Vec3 ct = w.truth[i].T_c_w.inverse().translation() - w.truth[0].T_c_w.inverse().translation();
+    EXPECT_LT((c - ct).norm(), 5e-3) << "keyframe " << i;
+    EXPECT_LT((w.window[i]->state.twist - w.truth[i].twist).norm(), 0.1) << "keyframe " << i;
+  }
+}
+
+// KNOWN LIMITATION, kept disabled as a record: with a loose twist prior (information 1) the twist is
+// nearly unobservable in this 4-keyframe window. Measured at the truth with the points eliminated: the
+// velocity twist has 0.06-0.26 information per (m/s)^2, the common-mode rotational twist eigenvalues
+// 1.4 (wy) and 3.9 (wx) (a common wx acts as a vertical stretch, wy as a shear, which a distorted world
+// absorbs); LM started at the truth moves to an energy 4 % lower with twists 0.77 m/s / 0.36 rad/s off.
+// The bounds below (twists within 0.1, centres 5 mm, GS fitting 1.5x worse) cannot hold there; the
+// rolling-shutter issue decides what the motion prior must supply.
 TEST(BundleAdjustment, DISABLED_RollingShutterWindowConvergesWithTwists) {
   const double line_delay = 30e-3 / 256;
   TestWindow w(4, true, line_delay);
