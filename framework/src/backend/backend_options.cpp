@@ -28,8 +28,6 @@ ParamTable backendParamTable() {
                   "inverse-depth information a leaving point needs to enter the prior (DSO: 50)"),
       paramInt("min_good_residuals", d.min_good_residuals, 1, 64, "",
                "inlier observations a point needs to be kept and marginalised (DSO: 3)"),
-      paramDouble("gauge_information", d.gauge_information, 1.0, 1e20, "",
-                  "information fixing the first keyframe's pose and brightness (the gauge)"),
       paramDouble("twist_regularization", d.twist_regularization, 0.0, 1e12, "s^2",
                   "information pulling a rolling-shutter twist to its start value when no motion prior gives one"),
       paramDouble("kf_weight_t", d.kf_weight_t, 0.0, 1e6, "", "keyframe score weight of the translation-only flow"),
@@ -86,7 +84,6 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.marg_project_scale = p.getBool("marg_project_scale");
   o.min_idepth_hessian_marg = p.getDouble("min_idepth_hessian_marg");
   o.min_good_residuals = static_cast<int>(p.getInt("min_good_residuals"));
-  o.gauge_information = p.getDouble("gauge_information");
   o.twist_regularization = p.getDouble("twist_regularization");
   o.kf_weight_t = p.getDouble("kf_weight_t");
   o.kf_weight_rt = p.getDouble("kf_weight_rt");

@@ -28,7 +28,6 @@ struct BackendOptions {
   bool marg_project_scale = true;     // project the scale direction at x_lin off marginalised points' terms
   double min_idepth_hessian_marg = 50.0;  // a point leaving the window goes into the prior above this (DSO)
   int min_good_residuals = 3;         // observations a point needs to be kept / marginalised (DSO: 3)
-  double gauge_information = 1e12;   // information fixing the first keyframe's pose and affine a, b
   double twist_regularization = 1e-6; // tiny information on twists without a prior (rolling shutter)
   // Keyframe selection (DSO's weights; the flows are RMS pixel shifts normalised by width + height).
   double kf_weight_t = 0.04 * (640 + 480);   // translation-only flow
