@@ -5,7 +5,9 @@
 #include <set>
 #include <sstream>
 
+#include "rsvio/config/validate.h"
 #include "rsvio/core/error.h"
+#include "rsvio/io/atomic_file.h"
 
 namespace fs = std::filesystem;
 
@@ -136,6 +138,29 @@ void applySet(nlohmann::json& config, const std::string& assignment) {
     if (part.empty()) throw ConfigError("--set " + assignment + ": empty component in key '" + path + "'");
     parts.push_back(part);
   }
+  if (value.is_null()) {
+    // Removing a key: every component must exist, else the null would silently change nothing (a typo
+    // such as effects.rolling_shuter=null). Reported like an unknown key of validation, with a did-you-mean
+    // among the keys present at that level.
+    const nlohmann::json* at = &config;
+    std::string sofar;
+    for (const auto& p : parts) {
+      const std::string here = sofar.empty() ? p : sofar + "." + p;
+      if (!at->is_object() || !at->contains(p)) {
+        std::vector<std::string> present;
+        if (at->is_object())
+          for (auto it = at->begin(); it != at->end(); ++it) present.push_back(it.key());
+        const std::string dym = didYouMean(p, present);
+        std::string list;
+        for (const auto& k : present) list += (list.empty() ? "" : ", ") + k;
+        throw ConfigError("--set " + assignment + ": " + here + ": unknown key, nothing to remove" +
+                          (dym.empty() ? "" : "; did you mean \"" + (sofar.empty() ? dym : sofar + "." + dym) + "\"?") +
+                          " (present" + (sofar.empty() ? "" : " in " + sofar) + ": " + (list.empty() ? "none" : list) + ")");
+      }
+      at = &at->at(p);
+      sofar = here;
+    }
+  }
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
     nlohmann::json& next = (*node)[parts[i]];
     if (next.is_null()) next = nlohmann::json::object();
@@ -160,10 +185,8 @@ nlohmann::json loadConfigWithSets(const std::string& path, const std::vector<std
 }
 
 void writeConfig(const nlohmann::json& config, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw Error(path + ": cannot write config");
-  out << config.dump(2) << "\n";
-  if (!out) throw Error(path + ": write failed");
+  const std::string text = config.dump(2) + "\n";
+  io::writeFileAtomic(path, [&](std::ostream& out) { out << text; }, "config");
 }
 
 }  // namespace rsvio

@@ -216,8 +216,24 @@ nlohmann::json validateParams(const nlohmann::json& params, const ParamTable& ta
   return out;
 }
 
+namespace {
+
+// The --set assignment whose key is the problem's path, lies under it or above it ("" when none).
+std::string blamedSet(const std::string& problem_path, const std::vector<std::string>& sets) {
+  auto under = [](const std::string& a, const std::string& b) {  // a == b or a inside b
+    return a == b || (a.size() > b.size() && a.compare(0, b.size(), b) == 0 && a[b.size()] == '.');
+  };
+  for (auto it = sets.rbegin(); it != sets.rend(); ++it) {  // the last --set of a key wins, so blame it
+    const std::string key = it->substr(0, it->find('='));
+    if (!problem_path.empty() && (under(problem_path, key) || under(key, problem_path))) return *it;
+  }
+  return "";
+}
+
+}  // namespace
+
 nlohmann::json validateConfig(const nlohmann::json& config, const ConfigSchema& schema, PluginHost& host,
-                              const std::string& origin) {
+                              const std::string& origin, const std::vector<std::string>& sets) {
   std::vector<ConfigProblem> problems;
   nlohmann::json out = nlohmann::json::object();
   if (!config.is_object()) throw ConfigError(origin + ": a config must be a JSON object, found " + config.dump());
@@ -261,10 +277,21 @@ nlohmann::json validateConfig(const nlohmann::json& config, const ConfigSchema& 
     }
   }
   if (!problems.empty()) {
+    // Each problem names where it came from: a --set argument, or the file.
+    std::vector<std::string> lines;
+    size_t from_sets = 0;
+    for (const auto& p : problems) {
+      const std::string set = blamedSet(p.path, sets);
+      if (!set.empty()) ++from_sets;
+      lines.push_back(set.empty() ? p.str() : "--set " + set + ": " + p.str());
+    }
     // One problem: one line. Several: a count line, then one line per problem.
-    if (problems.size() == 1) throw ConfigError(origin + ": " + problems.front().str());
-    std::string msg = origin + ": " + std::to_string(problems.size()) + " problems in the config";
-    for (const auto& p : problems) msg += "\n  " + p.str();
+    if (problems.size() == 1) throw ConfigError(from_sets ? lines.front() : origin + ": " + lines.front());
+    const std::string where = from_sets == problems.size() ? std::string("--set arguments")
+                              : from_sets ? origin + " and its --set arguments"
+                                          : origin;
+    std::string msg = where + ": " + std::to_string(problems.size()) + " problems in the config";
+    for (const auto& l : lines) msg += "\n  " + l;
     throw ConfigError(msg);
   }
   return out;

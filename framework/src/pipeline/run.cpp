@@ -85,7 +85,7 @@ void evaluate(const std::string& data_dir, const std::string& out, Report& repor
 
 nlohmann::json loadRunConfig(const std::string& path, const std::vector<std::string>& sets, PluginHost& host) {
   nlohmann::json raw = loadConfigWithSets(path, sets);
-  return validateConfig(raw, runConfigSchema(), host, path);
+  return validateConfig(raw, runConfigSchema(), host, path, sets);  // problems of a --set blame it
 }
 
 RunResult runPipeline(const RunRequest& request, PluginHost& host) {

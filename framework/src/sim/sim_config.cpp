@@ -84,9 +84,10 @@ nlohmann::json defaultEffects() {
   return {{"image_noise", {{"plugin", "effect.image_noise"}}}, {"imu_noise", {{"plugin", "effect.imu_noise"}}}};
 }
 
-nlohmann::json validateSimConfig(nlohmann::json config, PluginHost& host, const std::string& origin) {
+nlohmann::json validateSimConfig(nlohmann::json config, PluginHost& host, const std::string& origin,
+                                 const std::vector<std::string>& sets) {
   if (config.is_object() && !config.contains("effects")) config["effects"] = defaultEffects();
-  nlohmann::json effective = validateConfig(config, simConfigSchema(), host, origin);
+  nlohmann::json effective = validateConfig(config, simConfigSchema(), host, origin, sets);
   try {
     simSettings(effective);  // cross-field checks
   } catch (const ConfigError& e) {
@@ -99,7 +100,7 @@ nlohmann::json loadSimConfig(const std::string& path, const std::vector<std::str
                              std::optional<int64_t> seed, PluginHost& host) {
   nlohmann::json config = loadConfigWithSets(path, sets);
   if (seed) config["seed"] = *seed;
-  return validateSimConfig(std::move(config), host, path);
+  return validateSimConfig(std::move(config), host, path, sets);
 }
 
 SimSettings simSettings(const nlohmann::json& e) {

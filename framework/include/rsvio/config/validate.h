@@ -49,8 +49,11 @@ struct ConfigProblem {
 // Validates `config` against `schema`, loading plugins through `host` to read their parameter tables.
 // Returns the effective config (defaults filled). Throws ConfigError listing every problem, one per
 // line, first line "<origin>: N problem(s)".
+// `sets` are the --set assignments applied on top of the file: a problem at (or under, or above) a
+// --set key is blamed on that argument ("--set backend.activ_points=100: backend.activ_points: unknown
+// key; ...") instead of the file.
 nlohmann::json validateConfig(const nlohmann::json& config, const ConfigSchema& schema, PluginHost& host,
-                              const std::string& origin);
+                              const std::string& origin, const std::vector<std::string>& sets = {});
 
 // Validates one params object against a table (used for slots and sections); appends problems,
 // returns the params with defaults filled.

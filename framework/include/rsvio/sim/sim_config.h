@@ -43,7 +43,8 @@ nlohmann::json defaultEffects();
 nlohmann::json loadSimConfig(const std::string& path, const std::vector<std::string>& sets,
                              std::optional<int64_t> seed, PluginHost& host);
 // The same for a config already in memory (origin names it in messages).
-nlohmann::json validateSimConfig(nlohmann::json config, PluginHost& host, const std::string& origin);
+nlohmann::json validateSimConfig(nlohmann::json config, PluginHost& host, const std::string& origin,
+                                 const std::vector<std::string>& sets = {});  // sets: blamed for their problems
 
 // Everything but the effects, from an effective config, with cross-field checks.
 struct SimSettings {
