@@ -96,13 +96,15 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   result.effective_config = cfg;
   result.out_dir = request.out_dir;
 
+  if (request.out_dir.empty()) throw ConfigError("--out: empty output folder name; give a folder to write the run into");
+  // The dataset is opened before the output folder is created: a wrong --data leaves nothing behind.
+  auto source = host.create<DataSource>(cfg["source"]["plugin"], slotParams(cfg, "source"), "source");
+  source->open(request.data_dir);
+
   std::error_code ec;
   fs::create_directories(request.out_dir, ec);
   if (ec) throw Error(request.out_dir + ": cannot create output folder: " + ec.message());
   writeConfig(cfg, (fs::path(request.out_dir) / "config.json").string());
-
-  auto source = host.create<DataSource>(cfg["source"]["plugin"], slotParams(cfg, "source"), "source");
-  source->open(request.data_dir);
   const SensorSetup& sensors = source->sensors();
 
   Report& report = result.report;
