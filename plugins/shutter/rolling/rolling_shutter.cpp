@@ -26,7 +26,8 @@ class RollingShutter : public ShutterModel {
   void setCalibration(const CameraCalibration& calib) override {
     double ld = param_line_delay_us_ > 0.0 ? param_line_delay_us_ * 1e-6 : calib.line_delay_s;
     if (!(ld > 0.0) || !std::isfinite(ld)) {
-      throw ConfigError(std::string(kName) + " needs line_delay_us: the calibration has no line delay");
+      throw ConfigError(std::string(kName) + " needs line_delay_us: the calibration has no line delay; give it with "
+                        "--set shutter.params.line_delay_us=<microseconds per row> (readout time / image rows)");
     }
     const std::string readout = param_readout_ == "calibration" ? calib.readout : param_readout_;
     if (readout == "top_down") {

@@ -19,7 +19,9 @@ TEST(RollingShutter, NoLineDelayAnywhereIsAConfigError) {
     s->setCalibration(calibWithout());
     FAIL() << "accepted a rolling shutter without a line delay";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), "shutter.rolling needs line_delay_us: the calibration has no line delay");
+    EXPECT_EQ(std::string(e.what()), "shutter.rolling needs line_delay_us: the calibration has no line delay; give it "
+                                     "with --set shutter.params.line_delay_us=<microseconds per row> (readout time / "
+                                     "image rows)");
   }
 }
 
