@@ -14,6 +14,7 @@
 
 #include "commands.h"
 #include "render_hook.h"
+#include "run_summary.h"
 #include "rsvio/core/error.h"
 #include "rsvio/pipeline/run.h"
 #include "rsvio/plugin/host.h"
@@ -74,6 +75,7 @@ int runDemo(const std::string& out, const GlobalOptions& g) {
   std::fflush(stdout);
   RunResult res = runPipeline(req, host);
 
+  printRunWarnings(res.report, "demo");
   std::printf("rsvio demo: 3/3 rendering\n");
   std::fflush(stdout);
   renderRunOutputs(run_dir, g.verbosity);
@@ -87,7 +89,10 @@ int runDemo(const std::string& out, const GlobalOptions& g) {
                 "   model does not know; on its global-shutter twin, --set effects.rolling_shutter=null, gs_vo tracks)\n");
   }
   if (rep.eval) std::printf("  ATE (keyframes, %s): %.4f m\n", rep.eval->align.c_str(), rep.eval->ate_rmse_m);
-  for (const auto& [stage, ms] : rep.stage_ms) std::printf("  %-20s %.2f ms\n", stage.c_str(), ms);
+  const std::string not_used = notUsedLine(rep, data, res.effective_config["output"]["evaluate"].get<bool>());
+  if (!not_used.empty()) std::printf("  %s\n", not_used.c_str());
+  if (!rep.stage_ms.empty()) std::printf("  stage times (mean per call, ms):\n");
+  for (const auto& [stage, ms] : rep.stage_ms) std::printf("    %-20s %8.2f\n", stage.c_str(), ms);
   std::printf("outputs: %s (trajectory.tum, keyframes.tum, points.ply, states.csv, report.json)\n", run_dir.c_str());
   std::printf("figures: %s\n", (fs::path(run_dir) / "index.html").string().c_str());
   std::printf("next: the diagnosis loop (rsvio diagnose --run %s) is not available yet\n", run_dir.c_str());
