@@ -1,11 +1,17 @@
 // rsvio plugins [--json]: every plugin found on the search path, with kind, name, version, description
-// and its parameter table; libraries that were rejected are listed with the reason.
+// and its parameter table; libraries that were rejected are listed with the reason (exit 1). Then the
+// keys of the framework's own config sections (frontend, backend, output of a run config; scene, motion,
+// ... of a simulation config) from the same ParamTables that validate them (config/run_schema.cpp).
+#include <algorithm>
+#include <array>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 
 #include "commands.h"
+#include "rsvio/config/validate.h"
 #include "rsvio/plugin/host.h"
+#include "rsvio/sim/sim_config.h"
 
 namespace rsvio::app {
 
@@ -64,46 +70,121 @@ nlohmann::json toJson(const PluginInfo& i) {
   return j;
 }
 
+// One aligned table of parameters: columns sized to their longest cell (long units, long defaults and
+// long ranges do not push the description out of line).
+void printParamTable(const ParamTable& params, const std::string& indent, const std::string& prefix = "") {
+  std::vector<std::array<std::string, 6>> rows;
+  for (const auto& p : params) {
+    rows.push_back({prefix + p.key, paramTypeName(p.type), p.unit.empty() ? "-" : p.unit,
+                    p.default_value.is_null() ? "(required)" : p.default_value.dump(), rangeOf(p), p.description});
+  }
+  std::array<size_t, 6> w{};
+  for (const auto& r : rows)
+    for (size_t c = 0; c < 5; ++c) w[c] = std::max(w[c], r[c].size());
+  for (const auto& r : rows) {
+    std::string line = indent;
+    for (size_t c = 0; c < 5; ++c) {
+      if (w[c] == 0) continue;
+      line += r[c] + std::string(w[c] - r[c].size() + 2, ' ');
+    }
+    line += r[5];
+    std::cout << line << "\n";
+  }
+}
+
+nlohmann::json tableJson(const ParamTable& params) {
+  PluginInfo i;
+  i.params = params;
+  return toJson(i)["params"];
+}
+
+// The framework's own config sections (frontend, backend, output, ...) and top-level values of a schema.
+nlohmann::json schemaJson(const ConfigSchema& schema) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [key, e] : schema.entries) {
+    if (e.type == ConfigSchema::Entry::Type::Section) {
+      j[key] = {{"description", e.description}, {"params", tableJson(e.table)}};
+    } else if (e.type == ConfigSchema::Entry::Type::Value) {
+      j[key] = {{"description", e.value.description}, {"params", tableJson({e.value})}};
+    } else {
+      j[key] = {{"description", e.description}, {"kind", kindName(e.kind)},
+                {"multi", e.type == ConfigSchema::Entry::Type::MultiSlot}, {"default", e.default_plugin}};
+    }
+  }
+  return j;
+}
+
+void printSchema(const ConfigSchema& schema, const std::string& example) {
+  std::cout << "\n[" << schema.what << " keys] (" << example << ")\n";
+  ParamTable values;
+  for (const auto& [key, e] : schema.entries)
+    if (e.type == ConfigSchema::Entry::Type::Value) values.push_back(e.value);
+  if (!values.empty()) {
+    std::cout << "  top level\n";
+    printParamTable(values, "      ");
+  }
+  std::string slots;
+  for (const auto& [key, e] : schema.entries) {
+    if (e.type != ConfigSchema::Entry::Type::Slot && e.type != ConfigSchema::Entry::Type::MultiSlot) continue;
+    slots += "      " + key + std::string(key.size() < 14 ? 14 - key.size() : 1, ' ') +
+             (e.type == ConfigSchema::Entry::Type::MultiSlot ? "{\"<name>\": {\"plugin\": \"" : "{\"plugin\": \"") +
+             kindName(e.kind) + ".*\"" + (e.type == ConfigSchema::Entry::Type::MultiSlot ? "}}" : "}") +
+             (e.default_plugin.empty() ? "" : "  default " + e.default_plugin) + "  " + e.description + "\n";
+  }
+  if (!slots.empty()) std::cout << "  plugin slots (their params: the plugin's table above)\n" << slots;
+  for (const auto& [key, e] : schema.entries) {
+    if (e.type != ConfigSchema::Entry::Type::Section) continue;
+    std::cout << "  " << key << ": " << e.description << "\n";
+    printParamTable(e.table, "      ", key + ".");
+  }
+}
+
 }  // namespace
 
 void addPluginsCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
-  auto* sub = root.add_subcommand("plugins", "list every plugin: kind, name, version, description, parameters");
+  auto* sub = root.add_subcommand("plugins",
+                                  "list every plugin (kind, name, version, description, parameters) and the keys of "
+                                  "run and simulation configs");
   static bool as_json = false;
   sub->add_flag("--json", as_json, "print JSON instead of a table");
   sub->callback([&g, &r] {
     PluginHost host(PluginHost::defaultSearchPath(g.plugin_path));
     std::vector<std::string> rejected;
     auto infos = host.loadAll(&rejected);
+    const ConfigSchema run_schema = runConfigSchema();
+    const ConfigSchema sim_schema = sim::simConfigSchema();
     if (as_json) {
       nlohmann::json j;
       j["search_path"] = host.searchPath();
       j["plugins"] = nlohmann::json::array();
       for (const auto& i : infos) j["plugins"].push_back(toJson(i));
       j["rejected"] = rejected;
+      j["run_config"] = schemaJson(run_schema);
+      j["sim_config"] = schemaJson(sim_schema);
       std::cout << j.dump(2) << "\n";
     } else {
       std::string dirs;
       for (const auto& d : host.searchPath()) dirs += (dirs.empty() ? "" : ":") + d;
       std::cout << "plugin search path: " << dirs << "\n";
       for (PluginKind k : allKinds()) {
-        std::cout << "\n[" << kindName(k) << "]\n";
-        bool any = false;
-        for (const auto& i : infos) {
-          if (i.kind != k) continue;
-          any = true;
-          std::cout << "  " << i.name << " " << i.version << ": " << i.description << "\n";
-          for (const auto& p : i.params) {
-            std::cout << "      " << std::left << std::setw(22) << p.key << std::setw(7) << paramTypeName(p.type)
-                      << std::setw(8) << (p.unit.empty() ? "-" : p.unit) << " default " << std::setw(10)
-                      << p.default_value.dump() << " " << std::setw(16) << rangeOf(p) << " " << p.description
-                      << "\n";
-          }
+        std::vector<const PluginInfo*> of_kind;
+        for (const auto& i : infos)
+          if (i.kind == k) of_kind.push_back(&i);
+        if (of_kind.empty()) {
+          std::cout << "\n[" << kindName(k) << "] none yet\n";
+          continue;
         }
-        if (!any) std::cout << "  (none)\n";
+        std::cout << "\n[" << kindName(k) << "]\n";
+        for (const PluginInfo* i : of_kind) {
+          std::cout << "  " << i->name << " " << i->version << ": " << i->description << "\n";
+          printParamTable(i->params, "      ");
+        }
       }
+      printSchema(run_schema, "rsvio run --config; e.g. --set frontend.points=800");
+      printSchema(sim_schema, "rsvio simulate --config; e.g. --set motion.duration_s=10");
       for (const auto& e : rejected) std::cout << "\nrejected: " << e << "\n";
     }
-    r.exit_code = rejected.empty() ? 0 : 1;
+    r.exit_code = rejected.empty() ? kExitOk : kExitFailed;
   });
 }
 

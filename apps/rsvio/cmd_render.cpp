@@ -1,7 +1,11 @@
 // rsvio render --run DIR [--out DIR]: figures of a finished (or failed) run and its index.html.
 // Everything but the arguments lives in viz/ (rsvio/viz/render_run.h); docs/figures.md says what each
-// figure shows. Exit 0 when every figure was written; 1 with a one-line message when some could not be
-// (the others and the page are still written); 2 (from main) when the run folder does not exist.
+// figure shows. Without --out: <run>/figures/*.png and <run>/index.html. With --out X: X/*.png and
+// X/index.html, and the run folder is not touched (its own page keeps pointing at its own figures).
+// Exit 0 when every figure was written; 1 with a one-line message when some could not be (the others
+// and the page are still written); 2 when the run folder does not exist or holds nothing to draw (no
+// report.json, trajectory, keyframes, points or states: not a run folder), and nothing is written.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -29,8 +33,13 @@ int runRender(const RenderArgs& a, int verbosity) {
   so.dataset_dir = a.data;
   so.ground_truth_path = a.gt;
   const io::Snapshot snap = io::readSnapshot(a.run, so);  // DataError when the folder is missing
+  if (!snap.report.contains("status") && snap.trajectory.empty() && snap.keyframes.empty() && snap.points.size() == 0 &&
+      snap.states.empty())
+    throw DataError(a.run + ": nothing to draw: no report.json, trajectory.tum, keyframes.tum, points.ply or "
+                            "states.csv (is this a folder written by rsvio run?)");
   viz::RenderOptions o;
   o.out_dir = a.out;
+  if (!a.out.empty()) o.index_path = (std::filesystem::path(a.out) / "index.html").string();
   o.scene.width = a.width;
   o.scene.height = a.height;
   o.scenes = !a.no_3d;
@@ -56,8 +65,11 @@ void addRenderCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) 
 #ifdef RSVIO_HAVE_VIZ
   auto args = std::make_shared<RenderArgs>();
   auto* sub = root.add_subcommand("render", "figures and index.html of a run folder (off-screen, no window)");
-  sub->add_option("--run", args->run, "run folder written by rsvio run")->required();
-  sub->add_option("--out", args->out, "folder for the figures (default <run>/figures); index.html goes to <run>");
+  sub->add_option("--run", args->run, "run folder written by rsvio run")->required()->check(NonEmpty("run folder"));
+  sub->add_option("--out", args->out,
+                  "write the figures and index.html into this folder instead (the run folder is left untouched); "
+                  "default: <run>/figures and <run>/index.html")
+      ->check(NonEmpty("output folder"));
   sub->add_option("--data", args->data, "dataset folder for ground truth (default: report.json's \"dataset\")");
   sub->add_option("--gt", args->gt, "ground-truth file (EuRoC csv or TUM), instead of the dataset's");
   sub->add_option("--width", args->width, "3D view width in pixels")->capture_default_str();

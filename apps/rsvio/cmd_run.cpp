@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "render_hook.h"
+#include "run_summary.h"
 #include "rsvio/pipeline/run.h"
 #include "rsvio/plugin/host.h"
 
@@ -16,20 +17,25 @@ void addRunCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
   static RunRequest req;
   sub->add_option("--config", req.config_path, "run config (JSON)")->required()->check(CLI::ExistingFile);
   sub->add_option("--data", req.data_dir, "dataset folder (EuRoC/ASL layout)")->required();
-  sub->add_option("--out", req.out_dir, "output folder")->required();
-  sub->add_option("--seed", req.seed, "estimator seed (point selection); default: the config's");
+  sub->add_option("--out", req.out_dir, "output folder")->required()->check(NonEmpty("output folder"));
+  sub->add_option("--seed", req.seed, "estimator seed (point selection); default: the config's")
+      ->check(CLI::Range(0L, 2147483647L));
   sub->add_option("--set", req.sets, "override a config key: a.b.c=value")->take_all();
   sub->callback([&g, &r] {
     req.verbosity = g.verbosity;
     PluginHost host(PluginHost::defaultSearchPath(g.plugin_path));
     RunResult res = runPipeline(req, host);
     const Report& rep = res.report;
+    printRunWarnings(rep);  // every warning report.json records, once, on stderr
     if (res.effective_config["output"]["render"].get<bool>()) renderRunOutputs(res.out_dir, g.verbosity);
     if (rep.ok()) {
       std::printf("run ok: %ld frames, %ld keyframes, %.1f fps (realtime factor %.2f)", rep.frames, rep.keyframes,
                   rep.fps, rep.realtime_factor);
       if (rep.eval) std::printf(", ATE %.4f m (%s, keyframes)", rep.eval->ate_rmse_m, rep.eval->align.c_str());
-      std::printf("\noutputs in %s\n", res.out_dir.c_str());
+      std::printf("\n");
+      const std::string not_used = notUsedLine(rep, req.data_dir, res.effective_config["output"]["evaluate"].get<bool>());
+      if (!not_used.empty()) std::printf("%s\n", not_used.c_str());
+      std::printf("outputs in %s\n", res.out_dir.c_str());
       r.exit_code = 0;
     } else {
       std::cerr << "rsvio run: failed: " << rep.error << " (outputs so far in " << res.out_dir << ")\n";

@@ -71,7 +71,7 @@ void addSimulateCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r
   auto opts = std::make_shared<SimulateOptions>();
   auto* sub = root.add_subcommand("simulate", "write a synthetic rolling-shutter visual-inertial dataset (EuRoC layout + truth.json)");
   sub->add_option("--config", opts->config, "simulation config, e.g. configs/sim/rs.json")->required();
-  sub->add_option("--out", opts->out, "output folder")->required();
+  sub->add_option("--out", opts->out, "output folder")->required()->check(NonEmpty("output folder"));
   sub->add_option("--seed", opts->seed, "seed of every random stream (overrides the config's)")->check(CLI::NonNegativeNumber);
   sub->add_option("--set", opts->sets, "override one config key, e.g. --set motion.duration_s=10")->take_all();
   sub->add_option("--threads", opts->threads, "worker threads (same output for any count)")->check(CLI::PositiveNumber);

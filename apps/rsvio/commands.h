@@ -10,6 +10,13 @@
 
 namespace rsvio::app {
 
+// Exit codes, the same for every subcommand (README "Exit codes", user-contract.md).
+constexpr int kExitOk = 0;
+constexpr int kExitFailed = 1;        // a run (or a run of a grid) failed; its report says why
+constexpr int kExitUsage = 2;         // bad input or usage: one line on stderr naming the file, line or key
+constexpr int kExitNotAvailable = 3;  // not available in this build
+constexpr int kExitInterrupted = 130; // SIGINT/SIGTERM: outputs so far kept, report.json "interrupted"
+
 struct CommandResult {
   int exit_code = 0;
 };
@@ -28,6 +35,12 @@ void addEvalCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r);
 void addCompareCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r);
 void addDiagnoseCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r);
 void addRenderCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r);
+
+// A CLI11 check that a path option is not empty (`--out ""`): "--out: empty output folder name".
+inline CLI::Validator NonEmpty(const std::string& what) {
+  return CLI::Validator([what](std::string& s) { return s.empty() ? "empty " + what + " name" : std::string(); },
+                        "NONEMPTY");
+}
 
 // For commands whose issue has not landed: a clear message and exit code 3, never a silent success.
 int notAvailableYet(const std::string& command, const std::string& what_is_missing);

@@ -172,7 +172,10 @@ TEST_F(RenderRunTest, RenderCommand) {
                           (tmp.path / "log.txt").string() + " 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(tmp.path / "log.txt");
   EXPECT_TRUE(fs::exists(fs::path(out) / "trajectory_top.png"));
-  expectLinksResolve(run / "index.html");
+  // --out gets the page too; the run folder is not touched (its own page would lose its figures).
+  expectLinksResolve(fs::path(out) / "index.html");
+  EXPECT_FALSE(fs::exists(run / "index.html"));
+  EXPECT_FALSE(fs::exists(run / "figures"));
   const std::string bad = std::string(bin) + " render --run " + (tmp.path / "nope").string() + " > " +
                           (tmp.path / "log2.txt").string() + " 2>&1";
   EXPECT_NE(std::system(bad.c_str()), 0);
