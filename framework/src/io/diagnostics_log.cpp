@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/atomic_file.h"
 
 namespace rsvio {
 
@@ -25,8 +26,7 @@ struct Header {
 }  // namespace
 
 void DiagnosticsLog::write(const std::string& path) const {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw Error(path + ": cannot write diagnostics log");
+  io::writeFileAtomic(path, [&](std::ostream& out) {
   Header h{};
   std::memcpy(h.magic, kMagic, 8);
   h.version = kVersion;
@@ -41,7 +41,7 @@ void DiagnosticsLog::write(const std::string& path) const {
   out.write(reinterpret_cast<const char*>(observations.data()),
             static_cast<std::streamsize>(observations.size() * sizeof(ObservationRow)));
   out.write(reinterpret_cast<const char*>(imu.data()), static_cast<std::streamsize>(imu.size() * sizeof(ImuRow)));
-  if (!out) throw Error(path + ": write failed");
+  }, "diagnostics log", /*binary=*/true);
 }
 
 DiagnosticsLog DiagnosticsLog::read(const std::string& path) {
@@ -55,6 +55,12 @@ DiagnosticsLog DiagnosticsLog::read(const std::string& path) {
                     std::to_string(kVersion) + ")");
   in.seekg(0, std::ios::end);
   const auto size = static_cast<uint64_t>(in.tellg());
+  // Row counts are checked against the file size before any product, so a corrupt count can neither
+  // wrap the expected size around nor ask for a huge allocation.
+  const uint64_t body = size >= sizeof(h) ? size - sizeof(h) : 0;
+  if (h.n_obs > body / sizeof(ObservationRow) || h.n_imu > body / sizeof(ImuRow))
+    throw DataError(path + ": truncated or corrupt diagnostics log (" + std::to_string(size) + " bytes for " +
+                    std::to_string(h.n_obs) + " observation rows and " + std::to_string(h.n_imu) + " IMU rows)");
   const uint64_t expect = sizeof(h) + h.n_obs * sizeof(ObservationRow) + h.n_imu * sizeof(ImuRow);
   if (size != expect)
     throw DataError(path + ": truncated or corrupt diagnostics log (" + std::to_string(size) + " bytes, expected " +

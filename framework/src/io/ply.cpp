@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/atomic_file.h"
 
 namespace rsvio::io {
 namespace {
@@ -76,8 +77,7 @@ void writePly(const std::string& path, const PointCloud& cloud) {
     throw Error(path + ": point cloud has " + std::to_string(cloud.p_W.size()) + " positions but " +
                 std::to_string(cloud.intensity.size()) + " intensities");
   }
-  std::ofstream f(path);
-  if (!f) throw Error(path + ": cannot open for writing");
+  writeFileAtomic(path, [&](std::ostream& f) {
   f << "ply\nformat ascii 1.0\ncomment rsvio sparse point cloud, world frame\n"
     << "element vertex " << cloud.size() << "\n"
     << "property float x\nproperty float y\nproperty float z\nproperty float intensity\nend_header\n";
@@ -86,7 +86,7 @@ void writePly(const std::string& path, const PointCloud& cloud) {
     const auto& p = cloud.p_W[i];
     f << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << cloud.intensity[i] << '\n';
   }
-  if (!f) throw Error(path + ": write failed");
+  }, "point cloud");
 }
 
 PointCloud readPly(const std::string& path) {

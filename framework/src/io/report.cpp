@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/atomic_file.h"
 
 namespace rsvio {
 
@@ -39,8 +40,9 @@ Report Report::fromJson(const nlohmann::json& j, const std::string& origin) {
   try {
     if (!j.contains("status")) throw DataError(origin + ": missing key \"status\"");
     r.status = j.at("status").get<std::string>();
-    if (r.status != "ok" && r.status != "failed")
-      throw DataError(origin + ": status: expected \"ok\" or \"failed\", found \"" + r.status + "\"");
+    if (r.status != "ok" && r.status != "failed" && r.status != "interrupted")
+      throw DataError(origin + ": status: expected \"ok\", \"failed\" or \"interrupted\", found \"" + r.status +
+                      "\"");
     r.error = j.value("error", "");
     r.frames = j.value("frames", 0L);
     r.keyframes = j.value("keyframes", 0L);
@@ -71,10 +73,8 @@ Report Report::fromJson(const nlohmann::json& j, const std::string& origin) {
 }
 
 void Report::write(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw Error(path + ": cannot write report");
-  out << toJson().dump(2) << "\n";
-  if (!out) throw Error(path + ": write failed");
+  const std::string text = toJson().dump(2) + "\n";
+  io::writeFileAtomic(path, [&](std::ostream& out) { out << text; }, "report");
 }
 
 Report Report::read(const std::string& path) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/atomic_file.h"
 
 namespace rsvio {
 
@@ -16,8 +17,7 @@ constexpr int kColumns = 17;
 }  // namespace
 
 void writeStates(const std::vector<StateRow>& rows, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw Error(path + ": cannot write states");
+  io::writeFileAtomic(path, [&](std::ostream& out) {
   out << kHeader << "\n";
   char buf[64];
   for (const auto& r : rows) {
@@ -33,7 +33,7 @@ void writeStates(const std::vector<StateRow>& rows, const std::string& path) {
     put(r.scale);
     out << "\n";
   }
-  if (!out) throw Error(path + ": write failed");
+  }, "states");
 }
 
 std::vector<StateRow> readStates(const std::string& path) {

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/atomic_file.h"
 #include "rsvio/core/time.h"
 
 namespace rsvio::io {
@@ -202,11 +203,10 @@ std::string formatTumLine(const StampedPose& pose) {
 }
 
 void writeTum(const std::string& path, const Trajectory& traj) {
-  std::ofstream out(path);
-  if (!out) throw Error(path + ": cannot open for writing");
-  if (traj.frame != PoseFrame::kUnknown) out << "# frame: " << poseFrameName(traj.frame) << "\n";
-  for (const auto& p : traj.poses) out << formatTumLine(p) << "\n";
-  if (!out) throw Error(path + ": write failed");
+  writeFileAtomic(path, [&](std::ostream& out) {
+    if (traj.frame != PoseFrame::kUnknown) out << "# frame: " << poseFrameName(traj.frame) << "\n";
+    for (const auto& p : traj.poses) out << formatTumLine(p) << "\n";
+  }, "trajectory");
 }
 
 Trajectory readTum(const std::string& path) {

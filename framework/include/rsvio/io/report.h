@@ -1,6 +1,6 @@
 // report.json: the summary every run writes (user-contract.md, "Files a run writes").
 //
-//   {"status": "ok" | "failed", "error": "<one line, when failed>",
+//   {"status": "ok" | "failed" | "interrupted", "error": "<one line, when failed or interrupted>",
 //    "frames": N, "keyframes": N, "fps": f, "realtime_factor": fps / camera_rate_hz,
 //    "stage_ms": {"<stage>": mean ms per call, ...}, "scale": s (VIO only),
 //    "eval": {"ate_rmse_m": x, "align": "se3|sim3|none", ...} (when the dataset has ground truth),
