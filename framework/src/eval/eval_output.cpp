@@ -113,6 +113,12 @@ std::string formatEvalTable(const EvalResult& r, const EvalContext& ctx) {
   for (const auto& e : r.rpe) {
     const std::string drift =
         e.step.kind == RpeStep::Kind::kDistance && e.pairs ? std::to_string(e.drift_percent_mean).substr(0, 6) : "-";
+    if (e.pairs == 0) {  // no pair this far apart: nothing measured, not an error of 0
+      std::snprintf(buf, sizeof(buf), "  %-18s %5zu  %14s  %14s  %9s  %14s  %14s\n", stepLabel(e.step).c_str(), e.pairs,
+                    "-", "-", "-", "-", "-");
+      o << buf;
+      continue;
+    }
     std::snprintf(buf, sizeof(buf), "  %-18s %5zu  %14.6f  %14.6f  %9s  %14.4f  %14.4f\n", stepLabel(e.step).c_str(),
                   e.pairs, e.trans_m.rmse, e.trans_m.mean, drift.c_str(), e.rot_deg.rmse, e.rot_deg.mean);
     o << buf;
