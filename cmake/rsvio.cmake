@@ -20,3 +20,14 @@ function(rsvio_add_plugin kind name)
   target_compile_definitions(${tgt} PRIVATE RSVIO_PLUGIN_NAME="${kind}.${name}")
   set_property(GLOBAL APPEND PROPERTY RSVIO_PLUGIN_TARGETS ${tgt})
 endfunction()
+
+# Sanitizer build (scripts/sanitize.sh, its own build folder build-asan/): AddressSanitizer (with
+# LeakSanitizer) and UndefinedBehaviorSanitizer on every target, framework, plugins, apps and tests.
+# Any UB report aborts the program (-fno-sanitize-recover), so a test with a report fails.
+option(RSVIO_SANITIZE "Build with -fsanitize=address,undefined (scripts/sanitize.sh)" OFF)
+if(RSVIO_SANITIZE)
+  set(RSVIO_SANITIZE_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined -g1)
+  add_compile_options(${RSVIO_SANITIZE_FLAGS})
+  add_link_options(-fsanitize=address,undefined)
+  add_compile_definitions(RSVIO_SANITIZE=1)
+endif()
