@@ -3,6 +3,7 @@
 // keys of the framework's own config sections (frontend, backend, output of a run config; scene, motion,
 // ... of a simulation config) from the same ParamTables that validate them (config/run_schema.cpp).
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <iomanip>
 #include <iostream>
@@ -17,6 +18,17 @@ namespace rsvio::app {
 
 namespace {
 
+// Short numbers: 0.0001, 44.8, 1e+12 (6 significant digits), as a user would type them.
+std::string shortNum(double v) {
+  std::ostringstream ss;
+  if (std::abs(v) < 1e15 && v == std::floor(v)) ss << static_cast<long long>(v);  // 2147483647, not 2.14748e+09
+  else ss << v;
+  std::string t = ss.str();
+  // Whole numbers of 10 digits or more read better as powers of ten: 1000000000000 -> 1e+12.
+  if (t.size() >= 10 && t.find_first_not_of("0", 1) == std::string::npos && (t[0] == '1')) t = "1e+" + std::to_string(t.size() - 1);
+  return t;
+}
+
 std::string rangeOf(const ParamSpec& p) {
   if (p.type == ParamSpec::Type::Enum) {
     std::string s;
@@ -25,25 +37,20 @@ std::string rangeOf(const ParamSpec& p) {
   }
   if (p.type != ParamSpec::Type::Int && p.type != ParamSpec::Type::Double && p.type != ParamSpec::Type::DoubleArray)
     return "";
-  std::ostringstream ss;
-  ss << "[" << (p.min > -1e299 ? std::to_string(p.min) : std::string("-inf")) << ", "
-     << (p.max < 1e299 ? std::to_string(p.max) : std::string("inf")) << "]";
-  std::string s = ss.str();
-  // std::to_string prints 6 decimals; trim trailing zeros for readability.
-  std::string out;
-  for (size_t i = 0; i < s.size(); ++i) {
-    out += s[i];
-    if (s[i] == '.') {
-      size_t j = i + 1;
-      while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
-      std::string frac = s.substr(i + 1, j - i - 1);
-      while (!frac.empty() && frac.back() == '0') frac.pop_back();
-      if (frac.empty()) out.pop_back();
-      else out += frac;
-      i = j - 1;
-    }
+  return "[" + (p.min > -1e299 ? shortNum(p.min) : std::string("-inf")) + ", " +
+         (p.max < 1e299 ? shortNum(p.max) : std::string("inf")) + "]";
+}
+
+// A default as JSON, with doubles shortened (44.800000000000004 -> 44.8).
+std::string defaultText(const nlohmann::json& v) {
+  if (v.is_null()) return "(required)";
+  if (v.is_number_float()) return shortNum(v.get<double>());
+  if (v.is_array()) {
+    std::string s;
+    for (const auto& e : v) s += (s.empty() ? "" : ",") + defaultText(e);
+    return "[" + s + "]";
   }
-  return out;
+  return v.dump();
 }
 
 nlohmann::json toJson(const PluginInfo& i) {
@@ -76,7 +83,7 @@ void printParamTable(const ParamTable& params, const std::string& indent, const 
   std::vector<std::array<std::string, 6>> rows;
   for (const auto& p : params) {
     rows.push_back({prefix + p.key, paramTypeName(p.type), p.unit.empty() ? "-" : p.unit,
-                    p.default_value.is_null() ? "(required)" : p.default_value.dump(), rangeOf(p), p.description});
+                    defaultText(p.default_value), rangeOf(p), p.description});
   }
   std::array<size_t, 6> w{};
   for (const auto& r : rows)
@@ -123,15 +130,27 @@ void printSchema(const ConfigSchema& schema, const std::string& example) {
     std::cout << "  top level\n";
     printParamTable(values, "      ");
   }
-  std::string slots;
+  std::vector<std::array<std::string, 4>> slots;
   for (const auto& [key, e] : schema.entries) {
     if (e.type != ConfigSchema::Entry::Type::Slot && e.type != ConfigSchema::Entry::Type::MultiSlot) continue;
-    slots += "      " + key + std::string(key.size() < 14 ? 14 - key.size() : 1, ' ') +
-             (e.type == ConfigSchema::Entry::Type::MultiSlot ? "{\"<name>\": {\"plugin\": \"" : "{\"plugin\": \"") +
-             kindName(e.kind) + ".*\"" + (e.type == ConfigSchema::Entry::Type::MultiSlot ? "}}" : "}") +
-             (e.default_plugin.empty() ? "" : "  default " + e.default_plugin) + "  " + e.description + "\n";
+    const bool multi = e.type == ConfigSchema::Entry::Type::MultiSlot;
+    slots.push_back({key,
+                     multi ? std::string("{\"<name>\": {\"plugin\": \"") + kindName(e.kind) + ".*\"}}"
+                           : std::string("{\"plugin\": \"") + kindName(e.kind) + ".*\"}",
+                     e.default_plugin.empty() ? (multi ? "none by default" : "optional") : "default " + e.default_plugin,
+                     e.description});
   }
-  if (!slots.empty()) std::cout << "  plugin slots (their params: the plugin's table above)\n" << slots;
+  if (!slots.empty()) {
+    std::cout << "  plugin slots (their params: the plugin's table above)\n";
+    std::array<size_t, 3> w{};
+    for (const auto& r : slots)
+      for (size_t c = 0; c < 3; ++c) w[c] = std::max(w[c], r[c].size());
+    for (const auto& r : slots) {
+      std::string line = "      ";
+      for (size_t c = 0; c < 3; ++c) line += r[c] + std::string(w[c] - r[c].size() + 2, ' ');
+      std::cout << line << r[3] << "\n";
+    }
+  }
   for (const auto& [key, e] : schema.entries) {
     if (e.type != ConfigSchema::Entry::Type::Section) continue;
     std::cout << "  " << key << ": " << e.description << "\n";
