@@ -9,8 +9,9 @@ namespace {
 
 ParamTable table() {
   return {
-      paramEnum("mode", "auto", {"auto", "calibrated", "estimate"},
-                "auto: the dataset's vignette.png when given, else estimate a radial polynomial online"),
+      paramEnum("mode", "auto", {"auto", "calibrated", "estimate", "fixed"},
+                "auto: the dataset's vignette.png when given, else estimate a radial polynomial online; "
+                "fixed: divide by the polynomial `initial` as a calibration"),
       paramDouble("min_value", 0.05, 1e-3, 1.0, "", "calibrated vignette values are clamped to this before dividing"),
       paramArray("initial", {0.0, 0.0, 0.0}, 3, "", "initial v1 v2 v3 of V(r) = 1 + v1 r^2 + v2 r^4 + v3 r^6"),
   };
@@ -24,6 +25,7 @@ void registerAll(PluginRegistrar& r) {
         const std::string m = p.getString("mode");
         const VignetteModel::Mode mode = m == "calibrated" ? VignetteModel::Mode::Calibrated
                                          : m == "estimate" ? VignetteModel::Mode::Estimate
+                                         : m == "fixed"    ? VignetteModel::Mode::Fixed
                                                            : VignetteModel::Mode::Auto;
         const std::vector<double> v = p.getArray("initial");
         const std::string where = p.where().empty() ? "photometric.vignette" : p.where();

@@ -25,7 +25,7 @@ namespace rsvio {
 
 class VignetteModel : public PhotometricModel {
  public:
-  enum class Mode { Auto, Calibrated, Estimate };
+  enum class Mode { Auto, Calibrated, Estimate, Fixed };  // Fixed: `initial` applied as a calibration
 
   VignetteModel(Mode mode, double min_value, const Eigen::Vector3d& initial, std::string where = "photometric.vignette")
       : mode_(mode), min_value_(min_value), v_(initial), where_(std::move(where)) {}
@@ -42,6 +42,17 @@ class VignetteModel : public PhotometricModel {
     const cv::Mat& V = s.photometric.vignette;
     calibrated_ = false;
     if (mode_ == Mode::Estimate) return;
+    if (mode_ == Mode::Fixed) {
+      // The polynomial `initial` (e.g. what `rsvio diagnose` estimated) used as a calibration: every
+      // working image is divided by max(V(r), min_value).
+      if (cam.width <= 0 || cam.height <= 0) throw ConfigError(where_ + ".params.mode: \"fixed\" needs the image size");
+      inv_vignette_.create(cam.height, cam.width, CV_32FC1);
+      for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x)
+          inv_vignette_.at<float>(y, x) = static_cast<float>(1.0 / std::max(vignette(Vec2(x, y)), min_value_));
+      calibrated_ = true;
+      return;
+    }
     if (V.empty()) {
       if (mode_ == Mode::Calibrated)
         throw ConfigError(where_ + ".params.mode: \"calibrated\" but the dataset has no vignette calibration "

@@ -147,7 +147,7 @@ class RollingShutterProbe : public DiagnosticProbe {
 };
 
 ParamTable table() {
-  return {paramDouble("threshold", 3.0, 0.0, 1e6, "",
+  return {paramDouble("threshold", 4.0, 0.0, 1e6, "",
                       "|z| of the line-delay score test above which the effect is named (README: false-alarm rate)"),
           paramDouble("estimate_gain", 1.0, 0.0, 100.0, "",
                       "factor from the one-step line-delay estimate to the suggested line_delay_us"),

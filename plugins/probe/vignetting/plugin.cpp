@@ -68,7 +68,8 @@ class VignettingProbe : public DiagnosticProbe {
 ParamTable table() {
   return {paramDouble("threshold", 6.0, 0.0, 1e6, "",
                       "-z of the vignetting score test above which the effect is named (README: false-alarm rate)"),
-          paramDouble("estimate_gain", 1.0, 0.0, 100.0, "", "factor from the one-step k1 estimate to the suggested k1")};
+          paramDouble("estimate_gain", 2.0, 0.0, 100.0, "",
+                      "factor from the one-step k1 estimate to the suggested k1 (README: measured)")};
 }
 
 void registerAll(PluginRegistrar& r) {
