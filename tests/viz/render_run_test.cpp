@@ -2,6 +2,9 @@
 // existing files, failed runs render (with their error), a missing display is reported, not thrown.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -181,6 +184,32 @@ TEST_F(RenderRunTest, RenderCommand) {
   EXPECT_NE(std::system(bad.c_str()), 0);
   const std::string msg = slurp(tmp.path / "log2.txt");
   EXPECT_NE(msg.find("nope"), std::string::npos) << msg;
+}
+
+}  // namespace
+}  // namespace rsvio::viz
+
+namespace rsvio::viz {
+namespace {
+
+// A folder with only config.json (a run that never started, or the wrong folder): nothing to draw is
+// not a success; the command says so on one line, exits 2 and writes nothing.
+TEST_F(RenderRunTest, RenderCommandOnAFolderWithNothingToDrawIsAnError) {
+  const char* bin = std::getenv("RSVIO_BIN");
+  if (!bin) GTEST_SKIP() << "RSVIO_BIN not set (run through ctest)";
+  test::TempDir tmp("cli_empty");
+  const fs::path run = tmp.path / "run";
+  fs::create_directories(run);
+  std::ofstream(run / "config.json") << "{}";
+  const std::string cmd = std::string(bin) + " render --run " + run.string() + " > " + (tmp.path / "log.txt").string() +
+                          " 2>&1";
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2) << slurp(tmp.path / "log.txt");
+  const std::string msg = slurp(tmp.path / "log.txt");
+  EXPECT_NE(msg.find("nothing to draw"), std::string::npos) << msg;
+  EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 1) << msg;
+  EXPECT_FALSE(fs::exists(run / "figures"));
+  EXPECT_FALSE(fs::exists(run / "index.html"));
 }
 
 }  // namespace

@@ -40,7 +40,14 @@ struct RunSpec {
   // Ground-truth position of frame i; empty: no dataset.
   std::function<Eigen::Vector3d(int)> gt;
   bool points = true;
+  // Point i of the cloud (default: a ring of radius 4 m around (5, 0, 0)).
+  std::function<Eigen::Vector3d(int)> point = [](int i) {
+    const double a = i * 0.37;
+    return Eigen::Vector3d(5.0 + 4.0 * std::cos(a), 3.0 * std::sin(a), 0.5 * std::sin(3 * a));
+  };
+  int n_points = 300;
   bool states = true;
+  bool vo_states = false;          // states as a visual-odometry run writes them: only the twist is non-zero
   std::string frame = "body";
   std::string align;               // report.json eval.align ("" leaves eval out)
 };
@@ -79,9 +86,8 @@ inline fs::path makeRun(const fs::path& dir, const RunSpec& spec) {
   std::ofstream(run / "report.json") << report.dump(2);
   if (spec.points) {
     io::PointCloud pc;
-    for (int i = 0; i < 300; ++i) {
-      const double a = i * 0.37;
-      pc.p_W.emplace_back(5.0 + 4.0 * std::cos(a), 3.0 * std::sin(a), 0.5 * std::sin(3 * a));
+    for (int i = 0; i < spec.n_points; ++i) {
+      pc.p_W.push_back(spec.point(i));
       pc.intensity.push_back(static_cast<float>(i % 255));
     }
     io::writePly((run / "points.ply").string(), pc);
@@ -96,6 +102,12 @@ inline fs::path makeRun(const fs::path& dir, const RunSpec& spec) {
       r.ba = Eigen::Vector3d(0.01 * std::cos(0.05 * i), 0.02, -0.01);
       r.twist << 1.0, 0, 0, 0, 0, 0.05 * std::sin(0.1 * i);
       r.scale = 1.0 + 0.001 * i;
+      if (spec.vo_states) {
+        r.v.setZero();
+        r.bg.setZero();
+        r.ba.setZero();
+        r.scale = 1.0;
+      }
       rows.push_back(r);
     }
     writeStates(rows, (run / "states.csv").string());

@@ -288,19 +288,28 @@ void PlotArea::hline(double y, Rgb colour, int thickness, bool dashed) {
   for (double x = x0; x < x1; x += 2 * dash) c_.line({x, yy}, {std::min(x + dash, x1), yy}, colour, thickness);
 }
 
-void PlotArea::legend(const std::vector<std::pair<std::string, Rgb>>& entries) {
+void PlotArea::legend(const std::vector<std::pair<std::string, Rgb>>& entries, const std::vector<bool>& dashed) {
   if (entries.empty()) return;
   const double f = c_.baseFont() * 0.8;
   int w = 0;
   for (const auto& e : entries) w = std::max(w, c_.textSize(e.first, f).width);
-  const int line_len = static_cast<int>(f * 1.8), pad = static_cast<int>(f * 0.5), row = static_cast<int>(f * 1.4);
+  const int line_len = static_cast<int>(std::max(f * 2.6, 24.0)), pad = static_cast<int>(f * 0.5), row = static_cast<int>(f * 1.4);
   const int bw = pad * 3 + line_len + w, bh = pad * 2 + row * static_cast<int>(entries.size());
   const cv::Rect box(area_.x + area_.width - bw - pad, area_.y + pad, bw, bh);
   c_.fillRect(box, kWhite);
   c_.rect(box, kGrid);
   for (size_t i = 0; i < entries.size(); ++i) {
     const double y = box.y + pad + row * (i + 0.5);
-    c_.line({double(box.x + pad), y}, {double(box.x + pad + line_len), y}, entries[i].second, 3);
+    if (i < dashed.size() && dashed[i]) {
+      // Three dashes with clear gaps, as hline(..., dashed) draws the line.
+      const double d = 0.2 * line_len, gap = 0.2 * line_len;
+      for (int k = 0; k < 3; ++k) {
+        const double x = box.x + pad + k * (d + gap);
+        c_.line({x, y}, {x + d, y}, entries[i].second, 2);
+      }
+    } else {
+      c_.line({double(box.x + pad), y}, {double(box.x + pad + line_len), y}, entries[i].second, 3);
+    }
     c_.text(entries[i].first, box.x + 2 * pad + line_len, y, f, kText, HAlign::kLeft, VAlign::kMiddle);
   }
 }

@@ -91,8 +91,9 @@ class PlotArea {
   // Connected line; NaN values break it.
   void series(const std::vector<double>& x, const std::vector<double>& y, Rgb colour, int thickness = 2);
   void hline(double y, Rgb colour, int thickness = 1, bool dashed = false);
-  // Legend box in the upper right corner of the area: a short line per named entry.
-  void legend(const std::vector<std::pair<std::string, Rgb>>& entries);
+  // Legend box in the upper right corner of the area: a short line per named entry, dashed where
+  // dashed[i] is true (the swatch looks like the line it names).
+  void legend(const std::vector<std::pair<std::string, Rgb>>& entries, const std::vector<bool>& dashed = {});
 
  private:
   double mapX(double x) const;

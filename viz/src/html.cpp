@@ -68,7 +68,7 @@ th{background:#f4f4f4}td.n{text-align:right;font-variant-numeric:tabular-nums}
 .err{color:#c0392b;font-weight:600}.muted{color:#777}
 .figs{display:grid;grid-template-columns:repeat(auto-fill,minmax(540px,1fr));gap:18px}
 figure{margin:0;border:1px solid #e3e3e3;padding:8px;background:#fff}figure img{width:100%;height:auto;display:block}
-figure.wide{grid-column:1/-1}
+figure.wide{grid-column:1/-1}figure.wide img{width:auto;max-width:100%}
 figcaption{font-size:0.88em;color:#555;margin-top:6px}
 .bar{background:#4a90d9;height:10px;display:inline-block}
 pre{background:#f7f7f7;padding:10px;overflow:auto;font-size:0.85em}
@@ -175,7 +175,7 @@ void writeRunIndex(const std::string& index_path, const io::Snapshot& s, const s
   } else {
     double mx = 0;
     for (const auto& kv : s.summary.stage_ms) mx = std::max(mx, kv.second);
-    b << "<table><tr><th>stage</th><th>mean ms</th><th></th></tr>\n";
+    b << "<table><tr><th>stage</th><th>mean per call [ms]</th><th></th></tr>\n";
     for (const auto& [k, v] : s.summary.stage_ms) {
       const int w = mx > 0 ? static_cast<int>(std::lround(240.0 * v / mx)) : 0;
       b << "<tr><td>" << esc(k) << "</td><td class=\"n\">" << num(v) << "</td><td><span class=\"bar\" style=\"width:" << w
@@ -240,8 +240,8 @@ void writeCompareIndex(const std::string& index_path, const std::string& title, 
   b << "<h2>Figures</h2>\n";
   figuresSection(b, figures, index_path);
 
-  b << "<h2>Runs</h2>\n<table><tr><th>configuration</th><th>sequence</th><th>run</th><th>status</th><th>ATE [m]</th>"
-       "<th>run</th><th>error</th></tr>\n";
+  b << "<h2>Runs</h2>\n<table><tr><th>configuration</th><th>sequence</th><th>run #</th><th>status</th><th>ATE [m]</th>"
+       "<th>page</th><th>error</th></tr>\n";
   for (const auto& r : runs) {
     std::string link = "&ndash;";
     if (!r.run_dir.empty()) {

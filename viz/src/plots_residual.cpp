@@ -1,6 +1,7 @@
 // Residual heat maps from a diagnostics log (figures.h): mean |residual| per (time, raw row) bin and
 // per image cell. A rolling shutter left unmodelled shows as residuals that grow away from the middle
-// row y0 while the camera moves fast; vignetting shows as a ring in the image map.
+// row y0 while the camera moves fast; vignetting shows as a ring in the image map. Residuals are in grey
+// levels of the 8-bit image scale (0-255), as the photometric thresholds are.
 #include <algorithm>
 #include <cmath>
 
@@ -68,7 +69,7 @@ void drawHeat(Canvas& c, PlotArea& pa, const Bins& b, double x_lo, double x_hi, 
   const cv::Rect& a = pa.area();
   colourBar(c, cv::Rect(a.x + a.width + static_cast<int>(f * 1.2), a.y + static_cast<int>(f), static_cast<int>(f),
                         a.height - static_cast<int>(f)),
-            viridis, 0, vmax, false, "mean " + bar_label);
+            viridis, 0, vmax, false, "mean " + bar_label + " [grey levels]");
 }
 
 }  // namespace
@@ -109,6 +110,9 @@ void renderResidualRowTime(const ResidualMapInput& in, const std::string& path, 
   drawHeat(c, pa, b, 0, span_s, -0.5, in.image_height - 0.5, b.robustMax(), label);
   pa.drawAxes("Mean " + label + " by raw row and time (" + std::to_string(in.obs.size()) + " observations)", 8, 6, false);
   pa.hline(y0, kWhite, 1, true);
+  // The dashed line is explained in the figure itself, not only in a caption elsewhere.
+  c.text("dashed: middle row y0 = " + formatNumber(y0) + " (the row the image timestamp refers to)",
+         c.width() - f * 0.5, c.height() - f * 0.3, f * 0.75, kMuted, HAlign::kRight, VAlign::kBottom);
   saveOrThrow(c, path);
 }
 

@@ -77,16 +77,21 @@ void renderPanels(const std::vector<Panel>& panels, const std::string& message, 
     PlotArea pa(c, area + cv::Point(0, top), ax, ay);
     pa.drawAxes(p.title);
     std::vector<std::pair<std::string, Rgb>> legend;
+    std::vector<bool> dashed;
     for (const auto& h : p.hlines) {
       if (!std::isfinite(h.second)) continue;
       pa.hline(h.second, kRed, 1, true);
       legend.emplace_back(h.first, kRed);
+      dashed.push_back(true);  // reference lines are drawn dashed: so is their swatch
     }
     for (const auto& s : p.series) {
       pa.series(s.x, s.y, s.colour, 2);
-      if (!s.name.empty()) legend.emplace_back(s.name, s.colour);
+      if (!s.name.empty()) {
+        legend.emplace_back(s.name, s.colour);
+        dashed.push_back(false);
+      }
     }
-    if (legend.size() > 1 || (legend.size() == 1 && !p.hlines.empty())) pa.legend(legend);
+    if (legend.size() > 1 || (legend.size() == 1 && !p.hlines.empty())) pa.legend(legend, dashed);
   }
   saveOrThrow(c, path);
 }

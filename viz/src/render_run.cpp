@@ -24,13 +24,30 @@ void attempt(const std::string& what, RenderStatus& st, F&& f) {
   }
 }
 
-std::vector<Panel> statePanels(const std::vector<StateRow>& rows) {
+std::string failureText(const io::Snapshot& s) {
+  if (s.failed()) return "run failed" + (s.summary.error.empty() ? std::string() : ": " + s.summary.error);
+  return "";
+}
+
+}  // namespace
+
+std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool has_scale,
+                                       std::vector<std::string>* not_estimated) {
   std::vector<Panel> panels;
   if (rows.empty()) return panels;
+  auto allZero = [&](auto get) {
+    for (const auto& r : rows)
+      if (!(get(r).array() == 0).all()) return false;
+    return true;
+  };
   std::vector<double> t;
   for (const auto& r : rows) t.push_back((r.t_ns - rows.front().t_ns) * 1e-9);
   const Rgb axis_colour[3] = {{214, 39, 40}, {44, 160, 44}, {31, 119, 180}};
   auto vec3 = [&](const char* title, const char* ylabel, auto get, const char* n0, const char* n1, const char* n2) {
+    if (allZero([&](const StateRow& r) -> Eigen::Vector3d { return get(r); })) {
+      if (not_estimated) not_estimated->push_back(title);
+      return;
+    }
     Panel p;
     p.title = title;
     p.y_label = ylabel;
@@ -45,6 +62,8 @@ std::vector<Panel> statePanels(const std::vector<StateRow>& rows) {
   vec3("Velocity (world)", "v [m/s]", [](const StateRow& r) { return r.v; }, "x", "y", "z");
   vec3("Gyroscope bias", "bg [rad/s]", [](const StateRow& r) { return r.bg; }, "x", "y", "z");
   vec3("Accelerometer bias", "ba [m/s^2]", [](const StateRow& r) { return r.ba; }, "x", "y", "z");
+  const bool twist_zero = allZero([](const StateRow& r) -> Eigen::Matrix<double, 6, 1> { return r.twist; });
+  if (twist_zero && not_estimated) not_estimated->push_back("Keyframe twist");
   Panel tw;
   tw.title = "Keyframe twist (per second)";
   tw.y_label = "|xi|";
@@ -56,7 +75,12 @@ std::vector<Panel> statePanels(const std::vector<StateRow>& rows) {
   }
   tw.series = {trans, rot};
   tw.y_from_zero = true;
-  panels.push_back(std::move(tw));
+  if (!twist_zero) panels.push_back(std::move(tw));
+  if (!has_scale) {
+    if (not_estimated) not_estimated->push_back("Scale");
+    if (!panels.empty()) panels.back().x_label = "time since first keyframe [s]";
+    return panels;
+  }
   Panel sc;
   sc.title = "Scale (metres per visual unit)";
   sc.y_label = "scale";
@@ -67,13 +91,6 @@ std::vector<Panel> statePanels(const std::vector<StateRow>& rows) {
   panels.push_back(std::move(sc));
   return panels;
 }
-
-std::string failureText(const io::Snapshot& s) {
-  if (s.failed()) return "run failed" + (s.summary.error.empty() ? std::string() : ": " + s.summary.error);
-  return "";
-}
-
-}  // namespace
 
 ResidualMapInput residualMapInput(const DiagnosticsLog& log) {
   ResidualMapInput in;
@@ -107,10 +124,13 @@ RenderStatus renderRun(const io::Snapshot& s, const RenderOptions& o) {
         if (!guard.ok()) throw Error(guard.message());
         const auto files = renderScenes(s, o.scene, out.string());
         for (size_t i = 0; i < files.size(); ++i) {
-          add(files[i], files.size() < o.scene.views.size()
-                            ? std::string("3D view: nothing to draw")
-                            : std::string("3D, ") + viewName(o.scene.views[i]) +
-                                  " view: estimate against ground truth, coloured by error; points; keyframes");
+          const View v = o.scene.views[i];
+          add(files[i], files.size() < o.scene.views.size() ? std::string("3D view: nothing to draw")
+                        : v == View::kOverview
+                            ? std::string("3D overview: the whole scene (bulk of the point cloud) with the trajectory in it")
+                            : std::string("3D, ") + viewName(v) +
+                                  " view fitted to the trajectory: estimate against ground truth, coloured by error; "
+                                  "points near the path; keyframes");
         }
       });
     }
@@ -164,9 +184,19 @@ RenderStatus renderRun(const io::Snapshot& s, const RenderOptions& o) {
     if (!s.states.empty()) {
       attempt("states.png", st, [&] {
         const auto path = out / "states.png";
-        renderPanels(statePanels(s.states), "no keyframe states", path.string(),
-                     FigureSize{o.figure.width, o.figure.height * 2});
-        add(path, "Keyframe states: velocity, biases, twist magnitude, scale");
+        std::vector<std::string> missing;
+        const auto panels = keyframeStatePanels(s.states, std::isfinite(s.summary.scale), &missing);
+        std::string not_est;
+        for (const auto& m : missing) not_est += (not_est.empty() ? "" : ", ") + m;
+        std::string shown;
+        for (const auto& p : panels) shown += (shown.empty() ? "" : ", ") + p.title;
+        // About 0.4 of a figure's height per panel (at least one figure high).
+        const int h = std::max(o.figure.height, static_cast<int>(o.figure.height * 0.42 * panels.size()));
+        renderPanels(panels, "this run estimated no keyframe state besides the pose (not estimated: " + not_est + ")",
+                     path.string(), FigureSize{o.figure.width, panels.empty() ? o.figure.height : h});
+        add(path, panels.empty() ? "Keyframe states: none estimated besides the pose (" + not_est + ": not estimated)"
+                                 : "Keyframe states this run estimated: " + shown +
+                                       (not_est.empty() ? "" : ". Not estimated (no panel): " + not_est));
       });
     }
     std::optional<ResidualMapInput> residuals = o.residuals;

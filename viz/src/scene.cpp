@@ -29,6 +29,7 @@ const char* viewName(View v) {
     case View::kTop: return "top";
     case View::kSide: return "side";
     case View::kPerspective: return "perspective";
+    case View::kOverview: return "overview";
   }
   return "?";
 }
@@ -75,9 +76,26 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
   else if (s.errors) status += ", ATE " + fmt(s.errors->ate_m.rmse) + " m";
   if (!g.empty()) status += ", " + g.align_label;
 
+  vtkSmartPointer<vtkActor> near_points, all_points;
   if (!g.empty()) {
     if (!g.gt.empty()) scene->AddActor(makeLines(g.gt, std::vector<Rgb>(g.gt.size(), kGtColour), true, 1.5 * px));
-    if (!g.points.empty()) scene->AddActor(makePoints(g, std::max(1.0, 1.5 * px)));
+    if (!g.points.empty()) {
+      // Two clouds: the trajectory's neighbourhood for the fitted views, everything for the overview.
+      SceneGeometry near = g;
+      near.points.clear();
+      near.point_shade.clear();
+      for (size_t i = 0; i < g.points.size(); ++i) {
+        if (!g.point_near[i]) continue;
+        near.points.push_back(g.points[i]);
+        near.point_shade.push_back(g.point_shade[i]);
+      }
+      if (!near.points.empty()) {
+        near_points = makePoints(near, std::max(1.0, 1.5 * px));
+        scene->AddActor(near_points);
+      }
+      all_points = makePoints(g, std::max(1.0, 1.2 * px));
+      scene->AddActor(all_points);
+    }
     if (!g.frusta.empty()) scene->AddActor(makeFrusta(g, std::max(1.0, 0.75 * px)));
     if (!g.est.empty()) {
       std::vector<Rgb> col(g.est.size(), kPlainEstimate);
@@ -141,15 +159,18 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
                                sw / 2, H / 2.0, false, false, true));
   }
 
-  const Eigen::AlignedBox3d bounds = g.bounds.isEmpty() ? Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1))
-                                                        : g.bounds;
-  const Eigen::Vector3d c = bounds.center(), ext = bounds.sizes();
-  const double extent = std::max(1e-3, ext.maxCoeff());
-  const double spacing = detail::niceNumber(extent / 8.0);
-  vtkSmartPointer<vtkActor> grid;
+  // Each view frames its own box: the trajectory (top, side, perspective) or the whole scene (overview).
+  const Eigen::AlignedBox3d unit_box(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
+  const Eigen::AlignedBox3d fitted = g.bounds.isEmpty() ? unit_box : g.bounds;
+  const Eigen::AlignedBox3d whole = g.scene_bounds.isEmpty() ? fitted : g.scene_bounds;
+  auto spacingOf = [](const Eigen::AlignedBox3d& b) { return detail::niceNumber(std::max(1e-3, b.sizes().maxCoeff()) / 8.0); };
+  vtkSmartPointer<vtkActor> grid_fitted, grid_whole;
   if (!g.empty()) {
-    grid = makeGrid(bounds, spacing, bounds.min().z() - 0.02 * extent);
-    scene->AddActor(grid);
+    const double ef = std::max(1e-3, fitted.sizes().maxCoeff()), ew = std::max(1e-3, whole.sizes().maxCoeff());
+    grid_fitted = makeGrid(fitted, spacingOf(fitted), fitted.min().z() - 0.02 * ef);
+    grid_whole = makeGrid(whole, spacingOf(whole), whole.min().z() - 0.02 * ew);
+    scene->AddActor(grid_fitted);
+    scene->AddActor(grid_whole);
   }
 
   fs::create_directories(out_dir);
@@ -162,6 +183,15 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
       scene->AddViewProp(p);
       overlays.push_back(p);
     };
+    const bool overview = v == View::kOverview;
+    if (near_points) near_points->SetVisibility(!overview);
+    if (all_points) all_points->SetVisibility(overview);
+    if (grid_fitted) grid_fitted->SetVisibility(!overview);
+    if (grid_whole) grid_whole->SetVisibility(overview);
+    const Eigen::AlignedBox3d& bounds = overview ? whole : fitted;
+    const Eigen::Vector3d c = bounds.center(), ext = bounds.sizes();
+    const double extent = std::max(1e-3, ext.maxCoeff());
+    const double spacing = spacingOf(bounds);
     vtkCamera* cam = scene->GetActiveCamera();
     const double aspect = sw / H;
     // Fraction of the height kept clear for the title (top) and the legend (bottom).
@@ -193,7 +223,8 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
       cam->Zoom(1.15);
     }
     double half_h = 0;
-    if (v != View::kPerspective) {
+    const bool parallel = v == View::kTop || v == View::kSide;
+    if (parallel) {
       half_h = std::max({0.5 * eh * vmargin, 0.5 * ew * hmargin / aspect, 1e-3});
       cam->SetParallelScale(half_h);
     }
@@ -202,11 +233,12 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
     std::string title = s.name + ": " + viewName(v) + " view";
     if (v == View::kTop) title += " (x right, y up)";
     if (v == View::kSide) title += " (x right, z up)";
+    if (v == View::kOverview) title += " (whole scene)";
     overlay(makeText(title, font, Rgb{20, 20, 20}, font * 0.6, H - font * 0.5, true));
     overlay(makeText(status, static_cast<int>(font * 0.8), Rgb{90, 90, 90}, font * 0.6, H - font * 2.0, true));
     if (!g.empty()) {
       std::string grid_note = "grid " + fmt(spacing) + " " + g.unit;
-      if (v != View::kPerspective) {
+      if (parallel) {
         // Scale bar: a nice length near a fifth of the view's width, bottom right.
         const double px_per_unit = H / (2.0 * half_h);
         const double len = detail::niceNumber(0.2 * sw / px_per_unit);

@@ -49,9 +49,18 @@ SceneGeometry buildSceneGeometry(const io::Snapshot& s, bool points, bool frusta
   }
   g.unit = (aligned || s.poseFrame() == io::PoseFrame::kBody) ? "m" : "units";
 
+  // The trajectory views frame the trajectory (estimate and the ground truth it covers), not the room:
+  // a point cloud ten times the path's size would make the path a smear in a corner.
   g.bounds.setEmpty();
   for (const auto& p : g.est) g.bounds.extend(p);
   for (const auto& p : g.gt) g.bounds.extend(p);
+  const bool have_path = !g.bounds.isEmpty();
+  const double path_extent = have_path ? std::max(1e-3, g.bounds.sizes().maxCoeff()) : 0.0;
+  if (have_path) {
+    const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.5 * path_extent);
+    g.near_bounds = Eigen::AlignedBox3d(g.bounds.min() - grow, g.bounds.max() + grow);
+  }
+  g.scene_bounds = g.bounds;
 
   if (points && !s.points.empty()) {
     std::vector<double> inten;
@@ -64,23 +73,27 @@ SceneGeometry buildSceneGeometry(const io::Snapshot& s, bool points, bool frusta
       const Eigen::Vector3d p = aligned ? A.apply(s.points.p_W[i]) : s.points.p_W[i];
       if (!p.allFinite()) continue;
       g.points.push_back(p);
+      g.point_near.push_back(!have_path || g.near_bounds.contains(p));
       const double v = s.points.intensity[i];
       g.point_shade.push_back(std::isfinite(v) ? (hi > lo ? std::clamp((v - lo) / (hi - lo), 0.0, 1.0) : 0.5) : 0.5);
       xs.push_back(p.x());
       ys.push_back(p.y());
       zs.push_back(p.z());
     }
-    // Frame the bulk of the cloud, not its outliers (far points of a direct method are common).
+    // The overview frames the bulk of the cloud, not its outliers (far points of a direct method are common).
     if (g.points.size() >= 20) {
-      g.bounds.extend(Eigen::Vector3d(percentile(xs, 0.05), percentile(ys, 0.05), percentile(zs, 0.05)));
-      g.bounds.extend(Eigen::Vector3d(percentile(xs, 0.95), percentile(ys, 0.95), percentile(zs, 0.95)));
+      g.scene_bounds.extend(Eigen::Vector3d(percentile(xs, 0.05), percentile(ys, 0.05), percentile(zs, 0.05)));
+      g.scene_bounds.extend(Eigen::Vector3d(percentile(xs, 0.95), percentile(ys, 0.95), percentile(zs, 0.95)));
     } else {
-      for (const auto& p : g.points) g.bounds.extend(p);
+      for (const auto& p : g.points) g.scene_bounds.extend(p);
     }
+    if (!have_path) g.bounds = g.scene_bounds, g.near_bounds = g.scene_bounds;
   }
 
   const double extent = g.bounds.isEmpty() ? 1.0 : std::max(1e-3, g.bounds.sizes().maxCoeff());
-  g.frustum_size = 0.03 * extent;
+  // Frusta sized to the path: a few percent of its extent, and no deeper than the typical distance
+  // between two drawn keyframes, so they mark the keyframes without hiding the line.
+  g.frustum_size = 0.04 * extent;
   if (frusta && !s.keyframes.empty()) {
     const size_t n = s.keyframes.size();
     const size_t step = max_frusta > 0 && n > static_cast<size_t>(max_frusta) ? (n + max_frusta - 1) / max_frusta : 1;
@@ -96,6 +109,11 @@ SceneGeometry buildSceneGeometry(const io::Snapshot& s, bool points, bool frusta
       f.p_W_C = A.apply(T_W_C.translation());
       if (f.p_W_C.allFinite()) g.frusta.push_back(f);
     }
+    std::vector<double> gaps;
+    for (size_t i = 1; i < g.frusta.size(); ++i) gaps.push_back((g.frusta[i].p_W_C - g.frusta[i - 1].p_W_C).norm());
+    const double gap = percentile(gaps, 0.5);
+    if (gap > 0) g.frustum_size = std::min(g.frustum_size, 0.6 * gap);
+    g.frustum_size = std::max(g.frustum_size, 0.01 * extent);
   }
   if (g.empty()) {
     if (s.failed()) g.message = "run failed" + (s.summary.error.empty() ? std::string() : ": " + s.summary.error);

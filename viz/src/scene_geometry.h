@@ -21,9 +21,12 @@ struct SceneGeometry {
   std::vector<Eigen::Vector3d> gt;
   std::vector<Eigen::Vector3d> points;
   std::vector<double> point_shade;      // [0, 1] per point
+  std::vector<bool> point_near;         // per point: inside the trajectory's neighbourhood (near_bounds)
   std::vector<Frustum> frusta;
-  double frustum_size = 0.1;            // depth of a frustum, display units
-  Eigen::AlignedBox3d bounds;           // what the camera frames
+  double frustum_size = 0.1;            // depth of a frustum, display units: sized to the path
+  Eigen::AlignedBox3d bounds;           // what the trajectory views frame: the trajectory (and ground truth)
+  Eigen::AlignedBox3d near_bounds;      // bounds grown by half the trajectory's extent: points shown there
+  Eigen::AlignedBox3d scene_bounds;     // the overview: trajectory and the bulk of the point cloud
   std::string unit = "m";               // "m" when metric, "units" for an unaligned VO run
   std::string align_label;              // e.g. "Sim(3)-aligned on keyframes"
   std::string message;                  // set when there is nothing to draw: why

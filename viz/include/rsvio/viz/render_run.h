@@ -48,6 +48,13 @@ RenderStatus renderRun(const io::Snapshot& snapshot, const RenderOptions& option
 // Reads the snapshot first (a missing folder is reported in the status, not thrown).
 RenderStatus renderRunFolder(const std::string& run_dir, const RenderOptions& options = {});
 
+// The panels of states.png: only what the run estimated. A quantity that is exactly zero in every row of
+// states.csv was not estimated (a visual-odometry run has no velocity or biases; a global shutter may
+// have no twist) and gets no panel: its title goes to *not_estimated instead. Scale gets a panel only
+// when has_scale (report.json has a scale, as the run page shows it; visual odometry has none).
+std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool has_scale,
+                                       std::vector<std::string>* not_estimated = nullptr);
+
 // Mean-residual maps' input from a diagnostics log (every observation; weights kept).
 ResidualMapInput residualMapInput(const DiagnosticsLog& log);
 

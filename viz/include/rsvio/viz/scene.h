@@ -9,7 +9,10 @@
 // - keyframe frusta (camera poses: body poses are composed with T_B_C when the snapshot has it);
 // - a ground grid, a title (run, view, status, ATE), a legend, a colour bar for the error and, in the
 //   parallel top and side views, a scale bar.
-// Views: top (looking down -z, y up in the image), side (looking along +y, z up), perspective.
+// Views: top (looking down -z, y up in the image), side (looking along +y, z up), perspective: all three
+// fitted to the trajectory (estimate and ground truth), with the points cropped to its neighbourhood
+// (the trajectory's box grown by half its extent) and frusta sized to the path; overview: a perspective
+// of the whole scene (the bulk of the point cloud and the trajectory in it).
 // A snapshot without any geometry (a failed run) still gives a picture: the first asked view's file,
 // showing the reason (the other views are not written).
 //
@@ -23,13 +26,13 @@
 
 namespace rsvio::viz {
 
-enum class View { kTop, kSide, kPerspective };
-const char* viewName(View v);  // "top", "side", "perspective"
+enum class View { kTop, kSide, kPerspective, kOverview };
+const char* viewName(View v);  // "top", "side", "perspective", "overview"
 
 struct SceneOptions {
   int width = 1280;
   int height = 960;
-  std::vector<View> views = {View::kTop, View::kSide, View::kPerspective};
+  std::vector<View> views = {View::kTop, View::kSide, View::kPerspective, View::kOverview};
   bool show_points = true;
   bool show_frusta = true;
   bool show_ground_truth = true;
