@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -162,6 +163,30 @@ TEST_F(Newcomer, TruncatedImuLineIsAWarningOnStderr) {
   // With ground truth found, the summary does not claim it is missing.
   EXPECT_EQ(r.out.find("ground truth (none found"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("ATE"), std::string::npos) << r.out;
+}
+
+// rsvio eval: an RPE step longer than the sequence has no pair; its row says "-", not an error of 0.
+TEST_F(Newcomer, EvalRpeRowWithoutPairsPrintsDashes) {
+  const fs::path run = scratch() / "eval_run";
+  const Result r = rsvio("-q run --config " + kSrc + "/configs/gs_vo.json --data " + tinyData().string() + " --out " +
+                         run.string() + " --set output.render=false");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Result e = rsvio("eval --data " + tinyData().string() + " --est " + (run / "keyframes.tum").string() +
+                         " --rpe-windows-s 0.5,100");
+  ASSERT_EQ(e.code, 0) << e.err;
+  std::istringstream in(e.out);
+  std::string line;
+  bool saw_empty = false, saw_full = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("  100 s ", 0) == 0) {
+      saw_empty = true;
+      EXPECT_EQ(line.find("0.000000"), std::string::npos) << line;
+      EXPECT_EQ(std::count(line.begin(), line.end(), '-'), 5) << "pairs 0, every statistic '-': " << line;
+    }
+    if (line.rfind("  0.5 s ", 0) == 0) saw_full = std::count(line.begin(), line.end(), '-') == 1;  // drift only
+  }
+  EXPECT_TRUE(saw_empty) << e.out;
+  EXPECT_TRUE(saw_full) << e.out;
 }
 
 // ---- 3. A rolling-shutter run without a line delay says how to give it --------------------------------
