@@ -93,7 +93,7 @@ SceneGeometry buildSceneGeometry(const io::Snapshot& s, bool points, bool frusta
   const double extent = g.bounds.isEmpty() ? 1.0 : std::max(1e-3, g.bounds.sizes().maxCoeff());
   // Frusta sized to the path: a few percent of its extent, and no deeper than the typical distance
   // between two drawn keyframes, so they mark the keyframes without hiding the line.
-  g.frustum_size = 0.04 * extent;
+  g.frustum_size = 0.03 * extent;
   if (frusta && !s.keyframes.empty()) {
     const size_t n = s.keyframes.size();
     const size_t step = max_frusta > 0 && n > static_cast<size_t>(max_frusta) ? (n + max_frusta - 1) / max_frusta : 1;
@@ -112,7 +112,7 @@ SceneGeometry buildSceneGeometry(const io::Snapshot& s, bool points, bool frusta
     std::vector<double> gaps;
     for (size_t i = 1; i < g.frusta.size(); ++i) gaps.push_back((g.frusta[i].p_W_C - g.frusta[i - 1].p_W_C).norm());
     const double gap = percentile(gaps, 0.5);
-    if (gap > 0) g.frustum_size = std::min(g.frustum_size, 0.6 * gap);
+    if (gap > 0) g.frustum_size = std::min(g.frustum_size, 0.5 * gap);
     g.frustum_size = std::max(g.frustum_size, 0.01 * extent);
   }
   if (g.empty()) {
