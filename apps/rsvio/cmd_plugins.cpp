@@ -1,5 +1,5 @@
 // rsvio plugins [--json]: every plugin found on the search path, with kind, name, version, description
-// and its parameter table; libraries that were rejected are listed with the reason (exit 1). Then the
+// and its parameter table; libraries that were rejected are listed with the reason (exit 2). Then the
 // keys of the framework's own config sections (frontend, backend, output of a run config; scene, motion,
 // ... of a simulation config) from the same ParamTables that validate them (config/run_schema.cpp).
 #include <algorithm>
@@ -203,7 +203,11 @@ void addPluginsCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r)
       printSchema(sim_schema, "rsvio simulate --config; e.g. --set motion.duration_s=10");
       for (const auto& e : rejected) std::cout << "\nrejected: " << e << "\n";
     }
-    r.exit_code = rejected.empty() ? kExitOk : kExitFailed;
+    // A library on the search path that cannot be loaded is bad input (exit 2), said once on stderr too.
+    if (!rejected.empty())
+      std::cerr << "rsvio plugins: " << rejected.size() << " plugin librar" << (rejected.size() == 1 ? "y" : "ies")
+                << " rejected (listed " << (as_json ? "in \"rejected\"" : "at the end") << ")\n";
+    r.exit_code = rejected.empty() ? kExitOk : kExitUsage;
   });
 }
 

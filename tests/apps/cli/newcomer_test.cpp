@@ -280,4 +280,13 @@ TEST_F(Newcomer, PluginsTableIsAlignedAndListsFrameworkKeys) {
   EXPECT_FALSE(js["run_config"]["backend"]["params"].empty());
 }
 
+// A plugin folder holding libraries that cannot be loaded (tests' bad plugins): listed, exit 2, one line.
+TEST_F(Newcomer, RejectedPluginLibrariesAreBadInput) {
+  const Result r = rsvio(std::string("--plugin-path ") + RSVIO_TEST_PLUGIN_DIR + " plugins");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.out.find("rejected: "), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("rejected"), std::string::npos) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+}
+
 }  // namespace
