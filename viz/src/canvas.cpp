@@ -328,7 +328,12 @@ void colourBar(Canvas& c, const cv::Rect& bar, const std::function<Rgb(double)>&
     c.line({double(bar.x + bar.width), y}, {bar.x + bar.width + 4.0, y}, kAxis);
     c.text(formatNumber(v), bar.x + bar.width + 6.0, y, f, kText, HAlign::kLeft, VAlign::kMiddle);
   }
-  if (!label.empty()) c.text(label, bar.x + bar.width / 2.0, bar.y - f * 0.9, f, kText, HAlign::kCenter, VAlign::kBottom);
+  if (!label.empty()) {
+    // Centred on the bar, but kept inside the figure (a label with its unit is wider than the bar).
+    const double w = c.textSize(label, f).width;
+    const double x = std::min(bar.x + bar.width / 2.0, c.width() - w / 2.0 - 2.0);
+    c.text(label, x, bar.y - f * 0.9, f, kText, HAlign::kCenter, VAlign::kBottom);
+  }
 }
 
 void messageFigure(Canvas& c, const std::string& title, const std::vector<std::string>& lines, Rgb colour) {

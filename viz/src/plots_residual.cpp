@@ -106,7 +106,7 @@ void renderResidualRowTime(const ResidualMapInput& in, const std::string& path, 
   const cv::Rect area = plotRect(c, static_cast<int>(f * 6));
   // Pixel rows span [-0.5, h - 0.5]; row 0 is drawn at the top, as in the image.
   PlotArea pa(c, area, Axis{0, span_s, false, false, "time [s]"},
-              Axis{-0.5, in.image_height - 0.5, false, true, "raw image row"});
+              Axis{-0.5, in.image_height - 0.5, false, true, "raw image row [px]"});
   drawHeat(c, pa, b, 0, span_s, -0.5, in.image_height - 0.5, b.robustMax(), label);
   pa.drawAxes("Mean " + label + " by raw row and time (" + std::to_string(in.obs.size()) + " observations)", 8, 6, false);
   pa.hline(y0, kWhite, 1, true);
