@@ -164,3 +164,38 @@ TEST(Config, DidYouMean) {
   EXPECT_EQ(didYouMean("fronted", {"frontend", "backend", "output"}), "frontend");
   EXPECT_EQ(didYouMean("zzzzzz", {"frontend", "backend"}), "");
 }
+
+// A null on a key that does not exist would silently change nothing (a typo): an error with a
+// did-you-mean among the keys present at that level, also for a missing parent.
+TEST(Config, SetNullOnAMissingKeyIsAnError) {
+  json j = {{"effects", {{"rolling_shutter", {{"plugin", "effect.rolling_shutter"}}}, {"image_noise", json::object()}}}};
+  const std::string msg = errorOf([&] { applySet(j, "effects.rolling_shuter=null"); });
+  EXPECT_NE(msg.find("--set effects.rolling_shuter=null: effects.rolling_shuter: unknown key, nothing to remove; "
+                     "did you mean \"effects.rolling_shutter\"?"),
+            std::string::npos)
+      << msg;
+  EXPECT_TRUE(j["effects"].contains("rolling_shutter"));
+  EXPECT_NE(errorOf([&] { applySet(j, "efects.rolling_shutter=null"); }).find("did you mean \"effects\"?"),
+            std::string::npos);
+  EXPECT_FALSE(j.contains("efects")) << "a failed removal creates nothing";
+  applySet(j, "effects.rolling_shutter=null");
+  EXPECT_FALSE(j["effects"].contains("rolling_shutter"));
+}
+
+// Problems at a --set key (or under or above it) blame that argument; the file's own problems name it.
+TEST(Config, ValidationBlamesTheSetArgument) {
+  PluginHost host({RSVIO_TEST_PLUGIN_DIR});
+  const json cfg = json::parse(R"({"frontend": {"pionts": 3}, "nmae": "x"})");
+  const auto one = errorOf([&] {
+    validateConfig(json::parse(R"({"frontend": {"pionts": 3}})"), testSchema(), host, "cfg.json", {"frontend.pionts=3"});
+  });
+  EXPECT_EQ(one.rfind("--set frontend.pionts=3: frontend.pionts: unknown key; did you mean \"points\"?", 0), 0u) << one;
+  EXPECT_EQ(one.find("cfg.json"), std::string::npos) << one;
+  const auto two = errorOf([&] { validateConfig(cfg, testSchema(), host, "cfg.json", {"frontend.pionts=3"}); });
+  EXPECT_NE(two.find("cfg.json and its --set arguments: 2 problems"), std::string::npos) << two;
+  EXPECT_NE(two.find("\n  --set frontend.pionts=3: frontend.pionts: unknown key"), std::string::npos) << two;
+  EXPECT_NE(two.find("\n  nmae: unknown key"), std::string::npos) << two;
+  // A set of a whole section is blamed for the problems inside it.
+  const auto sec = errorOf([&] { validateConfig(cfg, testSchema(), host, "cfg.json", {"frontend={\"pionts\": 3}"}); });
+  EXPECT_NE(sec.find("--set frontend={\"pionts\": 3}: frontend.pionts"), std::string::npos) << sec;
+}
