@@ -1,6 +1,7 @@
 // points.ply writer and reader (rsvio/io/ply.h).
 #include "rsvio/io/ply.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -170,8 +171,11 @@ PointCloud readPly(const std::string& path) {
   }
 
   PointCloud cloud;
-  cloud.p_W.reserve(v.count);
-  cloud.intensity.reserve(v.count);
+  // The header's count is not trusted for the allocation (a corrupt count must not ask for terabytes);
+  // the file ending early is reported below.
+  const size_t reserve = std::min<size_t>(v.count, size_t{1} << 20);
+  cloud.p_W.reserve(reserve);
+  cloud.intensity.reserve(reserve);
   std::vector<double> values(v.props.size());
   auto store = [&]() {
     cloud.p_W.emplace_back(values[ix], values[iy], values[iz]);
