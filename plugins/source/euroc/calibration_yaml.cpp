@@ -42,11 +42,24 @@ YAML::Node loadYaml(const std::string& path) {
   } catch (const YAML::BadFile&) {
     throw DataError::at(path, 0, "cannot open calibration file");
   } catch (const YAML::Exception& e) {
+    // yaml-cpp's message may end in the offending byte itself (a newline, a control byte): printable
+    // escapes keep the message one line.
+    std::string msg;
+    for (const char c : e.msg) {
+      const auto u = static_cast<unsigned char>(c);
+      if (u >= 32 && u < 127) {
+        msg += c;
+      } else {
+        char b[8];
+        std::snprintf(b, sizeof(b), "\\x%02x", u);
+        msg += b;
+      }
+    }
     // yaml-cpp's own position, passed on so the user lands on the offending character.
     if (e.mark.line >= 0)
       throw DataError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                      ": invalid YAML: " + e.msg);
-    throw DataError::at(path, 0, "invalid YAML: " + e.msg);
+                      ": invalid YAML: " + msg);
+    throw DataError::at(path, 0, "invalid YAML: " + msg);
   }
 }
 
