@@ -92,6 +92,11 @@ nlohmann::json parseJsonText(const std::string& text, const std::string& origin)
     const auto colon = what.rfind(": ");
     std::string reason = colon == std::string::npos ? what : what.substr(colon + 2);
     throw ConfigError(origin + ":" + std::to_string(line) + ":" + std::to_string(col) + ": invalid JSON: " + reason);
+  } catch (const nlohmann::json::exception& e) {
+    // Not a syntax error but still unreadable, e.g. "number overflow parsing '1e400'" (found by fuzzing).
+    std::string what = e.what();
+    const auto bracket = what.find("] ");
+    throw ConfigError(origin + ": invalid JSON: " + (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
 }
 
@@ -117,7 +122,21 @@ nlohmann::json loadConfig(const std::string& path) {
   return j;
 }
 
+// True when s is well-formed UTF-8 (a JSON string must be: nlohmann throws on dumping anything else).
+static bool isUtf8(const std::string& s) {
+  for (size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xe ? 3 : (c >> 3) == 0x1e ? 4 : 0;
+    if (n == 0 || i + n > s.size()) return false;
+    for (size_t k = 1; k < n; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) >> 6) != 0x2) return false;
+    i += n;
+  }
+  return true;
+}
+
 void applySet(nlohmann::json& config, const std::string& assignment) {
+  if (!isUtf8(assignment)) throw ConfigError("--set: argument is not valid UTF-8 text");
   const auto eq = assignment.find('=');
   if (eq == std::string::npos)
     throw ConfigError("--set " + assignment + ": expected key=value (e.g. --set frontend.points=800)");
@@ -129,6 +148,8 @@ void applySet(nlohmann::json& config, const std::string& assignment) {
     value = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error&) {
     value = text;  // a bare word is a string: --set shutter.plugin=shutter.rolling
+  } catch (const nlohmann::json::exception& e) {
+    throw ConfigError("--set " + assignment + ": value is not usable JSON (" + e.what() + ")");
   }
   nlohmann::json* node = &config;
   std::stringstream ss(path);
