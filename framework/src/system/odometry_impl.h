@@ -12,6 +12,7 @@
 #include "rsvio/backend/bundle_adjustment.h"
 #include "rsvio/backend/marginalization.h"
 #include "rsvio/backend/mono_initializer.h"
+#include "rsvio/backend/smooth_motion_term.h"
 #include "rsvio/backend/window.h"
 #include "rsvio/frontend/candidate_points.h"
 #include "rsvio/frontend/frame_tracker.h"
@@ -100,6 +101,7 @@ struct Odometry::Impl {
   std::unique_ptr<FrameTracker> tracker;
   std::unique_ptr<CandidateTracer> tracer;
   std::unique_ptr<BundleAdjuster> ba;
+  std::unique_ptr<SmoothMotionTerm> smooth_motion;  // rolling shutter with a smooth-motion prior, else null
   std::unique_ptr<MarginalizationPrior> prior;
   std::unique_ptr<MonoInitializer> initializer;
   KeyframeList window;
@@ -138,6 +140,7 @@ struct Odometry::Impl {
   void fail(const std::string& reason);
   std::vector<SE3d> guesses(int64_t t_ns) const;
   Vec6 velocityEstimate() const;  // per second, from the last two tracked frames (0 without)
+  Vec6 frameTwistGuess() const;   // rolling shutter: a new frame's twist (see odometry.cpp)
   void pushHistory(const FrameRecord& f);
 
   // odometry_init.cpp
@@ -151,6 +154,8 @@ struct Odometry::Impl {
   void activateCandidates(Keyframe& newest);
   void removeOutliersAndMarginalizePoints(Keyframe& newest);
   void marginalizeKeyframe(Keyframe* kf);
+  void linkMotionNeighbours(Keyframe& kf);
+  void marginalizeMotionTerms(const Keyframe* leaving);
   void createCandidates(Keyframe& kf);
   void setTrackingReference(const Keyframe& newest);
   void checkDivergence();

@@ -63,6 +63,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   kf0->exposure_ms = ref.exposure_ms;
   kf0->pyramid = ref.pyramid;
   kf0->gauge = true;
+  kf0->motion_term = smooth_motion != nullptr;
   first_kf_id = kf0->kf_id;
   Keyframe& k0 = *kf0;
   window.push_back(std::move(kf0));

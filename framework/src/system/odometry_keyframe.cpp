@@ -305,6 +305,7 @@ void Odometry::Impl::marginalizeKeyframe(Keyframe* kf) {
   kf->points_out += static_cast<int>(kf->points.size());
   kf->points.clear();
   kf->candidates.clear();
+  marginalizeMotionTerms(kf);
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
   ba->keyframePriorTerm(*kf, &H, &b);
@@ -315,6 +316,40 @@ void Odometry::Impl::marginalizeKeyframe(Keyframe* kf) {
   window.erase(std::remove_if(window.begin(), window.end(), [&](const std::unique_ptr<Keyframe>& k) { return k.get() == kf; }),
                window.end());
   reindex(window);
+}
+
+// A new keyframe (not yet in the window) gets its smooth-motion term with the newest keyframe as its
+// previous neighbour; that keyframe's term gains the new one as its next (smooth_motion_term.h).
+void Odometry::Impl::linkMotionNeighbours(Keyframe& kf) {
+  if (!smooth_motion) return;
+  kf.motion_term = true;
+  kf.motion_prev = window.empty() ? nullptr : window.back().get();
+  kf.motion_next = nullptr;
+  if (kf.motion_prev && kf.motion_prev->motion_term) kf.motion_prev->motion_next = &kf;
+}
+
+// Every active smooth-motion term that involves `leaving` goes into the marginalisation prior
+// (linearised now, scale-free like the marginalised points) and is switched off.
+void Odometry::Impl::marginalizeMotionTerms(const Keyframe* leaving) {
+  if (!smooth_motion) return;
+  const int kd = ba->config().layout.kfDim();
+  for (auto& w : window) {
+    if (!w->motion_term || (w.get() != leaving && w->motion_prev != leaving && w->motion_next != leaving)) continue;
+    std::vector<Keyframe*> kfs;
+    Eigen::MatrixXd H;
+    Eigen::VectorXd b;
+    smooth_motion->linearizeOne(*w, ba->config().layout, &kfs, &H, &b);
+    w->motion_term = false;
+    if (kfs.empty()) continue;
+    for (size_t i = 0; i < kfs.size(); ++i)
+      if (kfs[i]->gauge) {  // fixed dimensions are zero in added terms (marginalization.h)
+        const Eigen::Index o = static_cast<Eigen::Index>(i) * kd;
+        H.middleRows(o, 6).setZero();
+        H.middleCols(o, 6).setZero();
+        b.segment(o, 6).setZero();
+      }
+    prior->addScaleFreeTerm(kfs, H, b, bo.marg_project_scale);
+  }
 }
 
 void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms,
@@ -351,6 +386,7 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
     kf->gauge = true;
     first_kf_id = kf->kf_id;
   }
+  linkMotionNeighbours(*kf);
   Keyframe* nk = kf.get();
   window.push_back(std::move(kf));
   reindex(window);

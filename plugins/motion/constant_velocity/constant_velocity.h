@@ -15,9 +15,13 @@
 //        combination of the camera axes (26 rotations, DSO's lastF_2_fh_tries), rotation about the
 //        new camera's centre: exp((0; d)) * guess 1.
 //   With one frame of history only 1 (= no motion) and its rotations; with none, nothing.
-// - twistPrior(): the keyframe's twist should match the frame-to-frame velocity around it (central
-//   difference of its neighbours in the history, one-sided at the ends); information diag(info_trans,
-//   info_rot). Returns false when the weights are zero or the history has no neighbour.
+// - Twist prior (rolling shutter), information diag(info_trans x3, info_rot x3), one of two kinds:
+//   "window" (default): smoothMotionInformation() hands the information to the back end's
+//     smooth-motion term: the keyframe's twist tied to the OPTIMISED poses of its neighbour keyframes
+//     (backend/smooth_motion_term.h), so twists and poses constrain each other;
+//   "history": twistPrior() gives a fixed mean, the frame-to-frame velocity around the keyframe in the
+//     tracked history (central difference of its neighbours, one-sided at the ends), set once.
+//   Both return false when the weights are zero; twistPrior() also when the history has no neighbour.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -33,6 +37,7 @@ struct ConstantVelocityOptions {
   double recovery_rotation_rad = 0.04;  // DSO: quaternion component 0.02, i.e. ~0.04 rad
   double twist_info_trans = 0.0;       // information of the twist prior, (s / unit)^2; 0 = no prior
   double twist_info_rot = 0.0;         // (s / rad)^2
+  bool twist_prior_in_window = true;   // "window" (smooth-motion term) or "history" (fixed mean)
 };
 
 class ConstantVelocityPrior : public MotionPrior {
@@ -86,6 +91,7 @@ class ConstantVelocityPrior : public MotionPrior {
 
   bool twistPrior(const std::vector<MotionState>& history, const MotionState& keyframe,
                   TwistPrior* prior) const override {
+    if (o_.twist_prior_in_window) return false;
     if (!(o_.twist_info_trans > 0.0 || o_.twist_info_rot > 0.0) || history.size() < 2) return false;
     // The keyframe's place in the time-ordered history.
     const auto it = std::lower_bound(history.begin(), history.end(), keyframe.t_ns,
@@ -110,6 +116,15 @@ class ConstantVelocityPrior : public MotionPrior {
       prior->mean = mean;
       prior->information.setZero();
       prior->information.diagonal() << Vec3::Constant(o_.twist_info_trans), Vec3::Constant(o_.twist_info_rot);
+    }
+    return true;
+  }
+
+  bool smoothMotionInformation(Mat6* information) const override {
+    if (!o_.twist_prior_in_window || !(o_.twist_info_trans > 0.0 || o_.twist_info_rot > 0.0)) return false;
+    if (information) {
+      information->setZero();
+      information->diagonal() << Vec3::Constant(o_.twist_info_trans), Vec3::Constant(o_.twist_info_rot);
     }
     return true;
   }

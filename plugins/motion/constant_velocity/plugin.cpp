@@ -18,6 +18,9 @@ ParamTable table() {
                   "information of the smooth-motion twist prior, translation (0: no prior)"),
       paramDouble("twist_info_rot", d.twist_info_rot, 0.0, 1e12, "s^2/rad^2",
                   "information of the smooth-motion twist prior, rotation (0: no prior)"),
+      paramEnum("twist_prior", "window", {"window", "history"},
+                "rolling shutter: window = twist tied to the optimised neighbour keyframe poses; history = "
+                "fixed mean from the tracked frame-to-frame velocity"),
   };
 }
 
@@ -30,6 +33,7 @@ void registerAll(PluginRegistrar& r) {
                        o.recovery_rotation_rad = p.getDouble("recovery_rotation_rad");
                        o.twist_info_trans = p.getDouble("twist_info_trans");
                        o.twist_info_rot = p.getDouble("twist_info_rot");
+                       o.twist_prior_in_window = p.getString("twist_prior") == "window";
                        return std::make_unique<ConstantVelocityPrior>(o);
                      });
 }

@@ -95,6 +95,11 @@ struct Keyframe {
   bool has_twist_prior = false; // paper eq. 33 or a smooth-motion prior (motion_prior.h)
   TwistPrior twist_prior;
   Vec6 twist_start = Vec6::Zero();  // where twist_regularization pulls when there is no prior
+  // Smooth-motion term inside the optimisation (backend/smooth_motion_term.h): the keyframe's motion
+  // neighbours (nullptr: none) and whether its term is still active (false once marginalised).
+  bool motion_term = false;
+  Keyframe* motion_prev = nullptr;
+  Keyframe* motion_next = nullptr;
 
   std::vector<ActivePoint> points;         // active points hosted here
   std::vector<CandidatePoint> candidates;  // waiting for activation (frontend/candidate_points.h)

@@ -9,8 +9,11 @@
 //   first is the prior's prediction, further ones are recovery guesses).
 // - IMU samples arrive through addImu() in time order on the IMU clock; a prior that ignores the IMU
 //   leaves addImu empty.
-// - twistPrior(): paper eq. 33 (IMU) or a smooth-motion prior (DSO-RS); returns false if this prior
-//   has no opinion.
+// - twistPrior(): a prior with a fixed mean on a keyframe's twist, set when the keyframe is made
+//   (paper eq. 33 from the IMU, or the tracked history); returns false if this prior has no opinion.
+// - smoothMotionInformation(): the information of the smooth-motion prior inside the window
+//   optimisation (backend/smooth_motion_term.h: the twist tied to the optimised poses of its
+//   neighbour keyframes, DSO-RS); returns false if this prior has none.
 #pragma once
 #include <vector>
 
@@ -51,6 +54,7 @@ class MotionPrior : public PluginBase {
                           TwistPrior* /*prior*/) const {
     return false;
   }
+  virtual bool smoothMotionInformation(Mat6* /*information*/) const { return false; }
 };
 
 }  // namespace rsvio

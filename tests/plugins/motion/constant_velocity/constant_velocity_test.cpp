@@ -68,14 +68,15 @@ TEST(ConstantVelocity, ShortHistories) {
   EXPECT_TRUE(g[0].isApprox(T, 1e-12));
 }
 
-TEST(ConstantVelocity, TwistPriorIsTheVelocityAroundTheKeyframe) {
+TEST(ConstantVelocity, HistoryTwistPriorIsTheVelocityAroundTheKeyframe) {
   const Vec6 v = twist(0.2, 0.1, -0.3, 0.05, 0.1, -0.2);
   const SE3d T0 = SE3d::exp(twist(0.5, 0, 0, 0, 0.3, 0));
   std::vector<MotionState> h;
   for (int i = 0; i < 4; ++i) h.push_back(state(i * 40'000'000LL, SE3d::exp(v * (0.04 * i)) * T0, i == 2));
   TwistPrior prior;
   EXPECT_FALSE(ConstantVelocityPrior().twistPrior(h, h[2], &prior));  // weights 0: no opinion
-  ConstantVelocityPrior p({true, 0.04, 10.0, 100.0});
+  ConstantVelocityPrior p({true, 0.04, 10.0, 100.0, /*twist_prior_in_window=*/false});
+  EXPECT_FALSE(p.smoothMotionInformation(nullptr));  // "history": no term in the window
   ASSERT_TRUE(p.twistPrior(h, h[2], &prior));
   EXPECT_TRUE(prior.mean.isApprox(v, 1e-9));
   EXPECT_DOUBLE_EQ(prior.information(0, 0), 10.0);
@@ -84,6 +85,22 @@ TEST(ConstantVelocity, TwistPriorIsTheVelocityAroundTheKeyframe) {
   ASSERT_TRUE(p.twistPrior(h, h[3], &prior));  // last frame: one-sided
   EXPECT_TRUE(prior.mean.isApprox(v, 1e-9));
   EXPECT_FALSE(p.twistPrior({h[0]}, h[0], &prior));
+}
+
+TEST(ConstantVelocity, WindowTwistPriorHandsItsInformationToTheBackEnd) {
+  const Vec6 v = twist(0.2, 0.1, -0.3, 0.05, 0.1, -0.2);
+  std::vector<MotionState> h;
+  for (int i = 0; i < 4; ++i) h.push_back(state(i * 40'000'000LL, SE3d::exp(v * (0.04 * i)), i == 2));
+  const ConstantVelocityPrior p({true, 0.04, 10.0, 100.0, /*twist_prior_in_window=*/true});
+  TwistPrior prior;
+  EXPECT_FALSE(p.twistPrior(h, h[2], &prior));  // no fixed mean: the back end ties the twist to the poses
+  Mat6 info;
+  ASSERT_TRUE(p.smoothMotionInformation(&info));
+  EXPECT_DOUBLE_EQ(info(0, 0), 10.0);
+  EXPECT_DOUBLE_EQ(info(2, 2), 10.0);
+  EXPECT_DOUBLE_EQ(info(3, 3), 100.0);
+  EXPECT_DOUBLE_EQ(info(0, 3), 0.0);
+  EXPECT_FALSE(ConstantVelocityPrior().smoothMotionInformation(&info));  // weights 0: none
 }
 
 TEST(ConstantVelocity, LoadsThroughTheHostWithItsParamTable) {
