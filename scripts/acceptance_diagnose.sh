@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Acceptance of the diagnosis loop (issue 15) at 640x512, 20 s, medium motion (as configs/sim/demo.json):
+# for each effect and seed, simulate with the effect hidden, run the model without its plugin, diagnose
+# from the run folder alone, run again with the named line, compare (diagnose --against). Clean data
+# with 5 seeds (gs_vo with and without affine brightness) must give verdict none. Prints the verdict table; not part of CI (about 2 min per case
+# on 2 cores).
+#
+#   scripts/acceptance_diagnose.sh [OUT]          (default out/acceptance_diagnose)
+#   EFFECTS="exposure vignetting" SEEDS="1 2 3" CLEAN_SEEDS="1 2 3 4 5" scripts/acceptance_diagnose.sh
+#
+# Effects: rolling_shutter (rs.json, 58.94 us per row = 30 ms readout), exposure (exposure.json, +-1 stop
+# over 8 s, 0.05 stops jitter), vignetting (vignette.json, corner at half), response (response.json,
+# gamma 2.2). time_offset needs the visual-inertial estimator and is not run yet.
+# The "before" model is configs/gs_vo.json; for exposure without affine brightness
+# (--set photometric.affine=null), since gs_vo already models it.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BIN="${RSVIO_BIN:-$ROOT/build/bin/rsvio}"
+OUT="${1:-out/acceptance_diagnose}"
+EFFECTS="${EFFECTS:-rolling_shutter exposure vignetting response}"
+SEEDS="${SEEDS:-1 2 3}"
+CLEAN_SEEDS="${CLEAN_SEEDS:-1 2 3 4 5}"
+CFG="$ROOT/configs"
+MOTION=(--set motion.mean_speed_m_s=0.6 --set motion.mean_rot_speed_deg_s=40.0
+        --set motion.mean_accel_m_s2=1.0 --set motion.mean_rot_accel_deg_s2=150.0)
+mkdir -p "$OUT"
+TABLE="$OUT/table.txt"
+
+simcfg() {
+  case "$1" in
+    rolling_shutter) echo "$CFG/sim/rs.json" ;;
+    exposure) echo "$CFG/sim/exposure.json" ;;
+    vignetting) echo "$CFG/sim/vignette.json" ;;
+    response) echo "$CFG/sim/response.json" ;;
+    clean|clean_noaffine) echo "$CFG/sim/gs.json" ;;
+  esac
+}
+base_sets() { case "$1" in exposure|clean_noaffine) echo "--set photometric.affine=null" ;; esac; }
+
+field() {  # field JSON_FILE PYTHON_EXPR
+  python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print($2)" "$1"
+}
+
+printf "%-16s %4s %-16s %-44s %12s %12s %8s %s\n" effect seed verdict "top: statistic / threshold (score)" \
+  "ATE before" "ATE after" ratio "evidence" | tee "$TABLE"
+
+one() {
+  local effect=$1 seed=$2
+  local d="$OUT/$effect-$seed"
+  local data="$OUT/data-$(basename "$(simcfg "$effect")" .json)-$seed"
+  mkdir -p "$d"
+  if [ ! -f "$data/.complete" ]; then  # simulated once per (config, seed), reused by later calls
+    rm -rf "$data"
+    "$BIN" simulate --config "$(simcfg "$effect")" --out "$data" --seed "$seed" "${MOTION[@]}" > "$d/sim.log" 2>&1
+    touch "$data/.complete"
+  fi
+  # shellcheck disable=SC2046
+  "$BIN" run --config "$CFG/gs_vo.json" --data "$data" --out "$d/before" $(base_sets "$effect") > "$d/before.log" 2>&1 || true
+  "$BIN" diagnose --run "$d/before" --json > "$d/diagnose.json" 2> "$d/diagnose.err" || true
+  local verdict line top ate_b ate_a="-" ratio="-" ev="-"
+  verdict=$(field "$d/diagnose.json" "d['verdict']")
+  top=$(field "$d/diagnose.json" "(lambda e: '%s %.3g / %.3g (%.2f)' % (e['effect'], e['statistic'], e['threshold'], e['score']))(d['ranking'][0]) if d['ranking'] else '-'")
+  ate_b=$(field "$d/before/report.json" "'%.4f' % d['eval']['ate_rmse_m'] if 'eval' in d else 'n/a'")
+  [ "$(field "$d/before/report.json" "d['status']")" = ok ] || ate_b="$ate_b(F)"
+  if [ "$verdict" != none ]; then
+    line=$(field "$d/diagnose.json" "d['config_line']")
+    # shellcheck disable=SC2046,SC2086
+    "$BIN" run --config "$CFG/gs_vo.json" --data "$data" --out "$d/after" $(base_sets "$effect") $line > "$d/after.log" 2>&1 || true
+    "$BIN" diagnose --run "$d/after" --against "$d/before" --json > "$d/against.json" 2>/dev/null || true
+    ate_a=$(field "$d/after/report.json" "'%.4f' % d['eval']['ate_rmse_m'] if 'eval' in d else 'n/a'")
+    [ "$(field "$d/after/report.json" "d['status']")" = ok ] || ate_a="$ate_a(F)"
+    ratio=$(field "$d/against.json" "'%.2f' % d['against']['ate_ratio'] if 'ate_ratio' in d['against'] else '-'")
+    ev=$(field "$d/against.json" "('gone' if d['against']['evidence_gone'] else 'still there') if 'evidence_gone' in d['against'] else '-'")
+  fi
+  printf "%-16s %4s %-16s %-44s %12s %12s %8s %s\n" "$effect" "$seed" "$verdict" "$top" "$ate_b" "$ate_a" "$ratio" "$ev" | tee -a "$TABLE"
+}
+
+for e in $EFFECTS; do for s in $SEEDS; do one "$e" "$s"; done; done
+for s in $CLEAN_SEEDS; do one clean "$s"; one clean_noaffine "$s"; done
+echo "table: $TABLE (per case: $OUT/<effect>-<seed>/{before,after,diagnose.json,against.json})"

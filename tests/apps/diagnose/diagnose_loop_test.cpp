@@ -1,0 +1,196 @@
+// The diagnosis loop on small simulated data (320x256, 3 s, configs/sim/tiny_gs.json with one hidden
+// effect): run the model without the effect's plugin, `rsvio diagnose` names the effect from the run
+// folder alone, the named config line makes the ATE fall clearly, and the evidence is gone in the new
+// run (`diagnose --against`). Clean data with three seeds gives verdict none. Deleting truth.json and the
+// ground truth changes neither the estimator's outputs nor the verdict.
+// Figures behind the chosen seeds and ratios: plugins/probe/*/README.md and docs/diagnose.md.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string bin() {
+  const char* b = std::getenv("RSVIO_BIN");
+  return b ? std::string(b) : std::string(RSVIO_BINARY_DIR) + "/bin/rsvio";
+}
+
+std::string configs() { return std::string(RSVIO_SOURCE_DIR) + "/configs"; }
+
+// Runs `rsvio <args>`, returns exit status; stdout into *out when given.
+int rsvio(const std::string& args, std::string* out = nullptr) {
+  const std::string cmd = bin() + " " + args + (out ? " 2>/dev/null" : " >/dev/null 2>&1");
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return -1;
+  std::string s;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) s.append(buf, n);
+  const int st = ::pclose(p);
+  if (out) *out = s;
+  return WEXITSTATUS(st);
+}
+
+fs::path workDir(const std::string& name) {
+  const fs::path d = fs::path(RSVIO_BINARY_DIR) / "test_out" / "diagnose" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+const std::string kExposure =
+    "'effects.exposure={\"plugin\":\"effect.exposure\",\"params\":{\"amplitude_stops\":0.5,\"period_s\":8.0,"
+    "\"jitter_stops\":0.03}}'";
+const std::string kVignette = "'effects.vignette={\"plugin\":\"effect.vignette\"}'";
+
+void simulate(const fs::path& data, int seed, const std::string& set = "") {
+  ASSERT_EQ(rsvio("simulate --config " + configs() + "/sim/tiny_gs.json --out " + data.string() + " --seed " +
+                  std::to_string(seed) + (set.empty() ? "" : " --set " + set)),
+            0);
+}
+
+// rsvio run of gs_vo with extra --set lines; returns report.json (status may be "failed": exit 1).
+nlohmann::json run(const fs::path& data, const fs::path& out, const std::string& sets) {
+  const int rc = rsvio("run --config " + configs() + "/gs_vo.json --data " + data.string() + " --out " + out.string() +
+                       " " + sets);
+  EXPECT_TRUE(rc == 0 || rc == 1) << "rsvio run exit " << rc;
+  std::ifstream in(out / "report.json");
+  return in ? nlohmann::json::parse(in) : nlohmann::json();
+}
+
+nlohmann::json diagnose(const fs::path& run_dir, const std::string& extra = "") {
+  std::string out;
+  EXPECT_EQ(rsvio("diagnose --run " + run_dir.string() + " --json " + extra, &out), 0);
+  return nlohmann::json::parse(out);
+}
+
+double ate(const nlohmann::json& report) {
+  if (report.contains("eval") && report["eval"].contains("ate_rmse_m")) return report["eval"]["ate_rmse_m"];
+  return 1e9;  // a run that failed before it could be evaluated counts as a large error
+}
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void checkContractShape(const nlohmann::json& d) {
+  ASSERT_TRUE(d.contains("verdict"));
+  ASSERT_TRUE(d.contains("ranking"));
+  for (const auto& e : d["ranking"])
+    for (const char* k : {"effect", "score", "plugin", "config_line", "statistic", "threshold"})
+      EXPECT_TRUE(e.contains(k)) << k;
+}
+
+// The loop for one effect: the diagnosis names `effect` first, its line makes the ATE fall by
+// `min_ratio`, the evidence is gone in the new run.
+void loop(const fs::path& dir, const fs::path& data, const std::string& base_sets, const std::string& effect,
+          double min_ratio, bool evidence_must_go = true) {
+  const nlohmann::json before = run(data, dir / "before", base_sets);
+  const nlohmann::json d = diagnose(dir / "before");
+  checkContractShape(d);
+  ASSERT_EQ(d["verdict"], effect) << d.dump(1);
+  ASSERT_EQ(d["ranking"][0]["effect"], effect);
+  const std::string line = d["config_line"];
+  const nlohmann::json after = run(data, dir / "after", base_sets + " " + line);
+  EXPECT_EQ(after.value("status", ""), "ok") << after.dump(1);
+  EXPECT_GT(ate(before), min_ratio * ate(after)) << "ATE before " << ate(before) << " after " << ate(after)
+                                                  << " with " << line;
+  const nlohmann::json cmp = diagnose(dir / "after", "--against " + (dir / "before").string());
+  EXPECT_EQ(cmp["verdict"], "none") << cmp.dump(1);
+  EXPECT_EQ(cmp["against"]["before_verdict"], effect);
+  ASSERT_TRUE(cmp["against"].contains("evidence_gone"));
+  if (evidence_must_go) EXPECT_TRUE(cmp["against"]["evidence_gone"].get<bool>()) << cmp["against"].dump(1);
+  // The figures exist and the run page links them.
+  ASSERT_FALSE(d["figures"].empty());
+  for (const auto& f : d["figures"]) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;
+  const std::string page = readFile(dir / "before" / "index.html");
+  EXPECT_NE(page.find("figures/diagnose_" + effect + ".png"), std::string::npos);
+}
+
+// Exposure (0.5 stops over 8 s, 0.03 stops per frame), gs_vo without affine brightness, seed 3: measured
+// ATE 6.4 mm -> 1.4 mm with the named line (4.5x); asked: 2x.
+TEST(DiagnoseLoop, ExposureNamedAndAffineMakesTheErrorFall) {
+  const fs::path dir = workDir("exposure");
+  simulate(dir / "data", 3, kExposure);
+  loop(dir, dir / "data", "--set photometric.affine=null", "exposure", 2.0);
+
+  // Without truth.json and the ground truth: the same estimator outputs and the same verdict.
+  fs::copy(dir / "data", dir / "blind", fs::copy_options::recursive);
+  fs::remove(dir / "blind" / "truth.json");
+  fs::remove_all(dir / "blind" / "mav0" / "state_groundtruth_estimate0");
+  fs::remove_all(dir / "blind" / "mav0" / "mocap0");
+  ASSERT_FALSE(fs::exists(dir / "blind" / "truth.json"));
+  run(dir / "blind", dir / "blind_run", "--set photometric.affine=null");
+  for (const char* f : {"trajectory.tum", "keyframes.tum", "diagnostics.bin", "points.ply"})
+    EXPECT_EQ(readFile(dir / "before" / f), readFile(dir / "blind_run" / f)) << f << " differs without ground truth";
+  const nlohmann::json a = diagnose(dir / "before", "--no-figures");
+  const nlohmann::json b = diagnose(dir / "blind_run", "--no-figures");
+  EXPECT_EQ(a["verdict"], b["verdict"]);
+  EXPECT_EQ(a["ranking"].size(), b["ranking"].size());
+  for (size_t i = 0; i < a["ranking"].size() && i < b["ranking"].size(); ++i) {
+    EXPECT_EQ(a["ranking"][i]["effect"], b["ranking"][i]["effect"]);
+    EXPECT_EQ(a["ranking"][i]["statistic"], b["ranking"][i]["statistic"]);
+    EXPECT_EQ(a["ranking"][i]["config_line"], b["ranking"][i]["config_line"]);
+  }
+}
+
+// Vignetting (corner at half the centre), gs_vo with affine brightness, seed 2: measured ATE 20 mm ->
+// 4.6 mm with the named line (photometric.vignette mode fixed, k1 from the evidence); asked: 2x.
+// The suggested k1 (-0.32) corrects only part of the fall-off, so the vignetting evidence stays above
+// its threshold in the new run (20.6 -> 20.6; with the true polynomial it falls to 3.4): the log has
+// no host pixel, and the one-step estimate is biased towards 0 (plugins/probe/vignetting/README.md).
+TEST(DiagnoseLoop, VignettingNamedAndTheSuggestedPolynomialMakesTheErrorFall) {
+  const fs::path dir = workDir("vignetting");
+  simulate(dir / "data", 2, kVignette);
+  loop(dir, dir / "data", "", "vignetting", 2.0, /*evidence_must_go=*/false);
+}
+
+// Clean data, three seeds, gs_vo with and without affine brightness: verdict none.
+TEST(DiagnoseLoop, CleanDataGivesNone) {
+  const fs::path dir = workDir("clean");
+  for (int seed : {1, 3, 4}) {
+    const fs::path data = dir / ("data" + std::to_string(seed));
+    simulate(data, seed);
+    for (const std::string sets : {"", "--set photometric.affine=null"}) {
+      const fs::path out = dir / ("run" + std::to_string(seed) + (sets.empty() ? "_affine" : "_noaffine"));
+      run(data, out, sets);
+      const nlohmann::json d = diagnose(out, "--no-figures");
+      checkContractShape(d);
+      EXPECT_EQ(d["verdict"], "none") << "seed " << seed << " " << sets << ": " << d.dump(1);
+    }
+  }
+}
+
+// A run that fails part way is diagnosed from what it wrote, and says how much data it had.
+TEST(DiagnoseLoop, FailedRunIsDiagnosedAndSaysHowMuchDataItHad) {
+  const fs::path dir = workDir("failed");
+  // Vignetting, seed 3: gs_vo loses track part way (measured: frame 51 of 57).
+  simulate(dir / "data", 3, kVignette);
+  const nlohmann::json rep = run(dir / "data", dir / "run", "");
+  ASSERT_EQ(rep.value("status", ""), "failed") << rep.dump(1);
+  std::string text;
+  ASSERT_EQ(rsvio("diagnose --run " + (dir / "run").string(), &text), 0);
+  EXPECT_NE(text.find("failed"), std::string::npos) << text;
+  EXPECT_NE(text.find("frame pairs"), std::string::npos) << text;
+  const nlohmann::json d = diagnose(dir / "run", "--no-figures");
+  EXPECT_GT(d["data"]["usable_observations"].get<long>(), 0);
+  EXPECT_EQ(d["run_status"]["status"], "failed");
+  EXPECT_EQ(d["verdict"], "vignetting") << d.dump(1);
+}
+
+TEST(DiagnoseLoop, MissingRunFolderIsABadInput) {
+  std::string out;
+  EXPECT_EQ(rsvio("diagnose --run /nonexistent/run --json", &out), 2);
+}
+
+}  // namespace
