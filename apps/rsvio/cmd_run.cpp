@@ -1,6 +1,7 @@
 // rsvio run --config FILE --data DIR --out DIR [--seed N] [--set key=value ...]
 // Exit codes: 0 run ok; 1 the run failed (diverged, lost, unreadable frame: report.json says why);
-// 2 bad input before the run started (config, dataset, plugins).
+// 2 bad input before the run started (config, dataset, plugins); 130 interrupted by SIGINT/SIGTERM (the
+// outputs so far are written, report.json status "interrupted").
 #include <cstdio>
 #include <iostream>
 
@@ -24,9 +25,15 @@ void addRunCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
   sub->callback([&g, &r] {
     req.verbosity = g.verbosity;
     PluginHost host(PluginHost::defaultSearchPath(g.plugin_path));
+    installRunInterruptHandlers();  // Ctrl-C / SIGTERM: stop at the next frame, keep the outputs, exit 130
     RunResult res = runPipeline(req, host);
     const Report& rep = res.report;
     printRunWarnings(rep);  // every warning report.json records, once, on stderr
+    if (rep.status == "interrupted") {
+      std::cerr << "rsvio run: " << rep.error << " (outputs so far in " << res.out_dir << ")\n";
+      r.exit_code = 130;
+      return;
+    }
     if (res.effective_config["output"]["render"].get<bool>()) renderRunOutputs(res.out_dir, g.verbosity);
     if (rep.ok()) {
       std::printf("run ok: %ld frames, %ld keyframes, %.1f fps (realtime factor %.2f)", rep.frames, rep.keyframes,

@@ -3,7 +3,10 @@
 // lines, write the user contract's files (also after a failure) and evaluate against ground truth.
 #include "rsvio/pipeline/run.h"
 
+#include <signal.h>
+
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -28,6 +31,37 @@ namespace rsvio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+volatile std::sig_atomic_t g_interrupt_signal = 0;
+
+extern "C" void onRunInterrupt(int sig) {
+  if (g_interrupt_signal != 0) {
+    // Second signal: the default action, now (outputs are atomic, so nothing is left half-written).
+    ::signal(sig, SIG_DFL);
+    ::raise(sig);
+    return;
+  }
+  g_interrupt_signal = sig;
+}
+
+// Removes what an earlier run left in `out` (report.json first), so no stale file outlives its run.
+void cleanRunFolder(const std::string& out) {
+  std::error_code ec;
+  if (!fs::is_directory(out, ec)) return;
+  for (const auto& name : runOutputFiles()) {
+    fs::remove(fs::path(out) / name, ec);
+    if (ec) throw Error((fs::path(out) / name).string() + ": cannot remove the earlier run's file: " + ec.message());
+  }
+  fs::remove_all(fs::path(out) / "figures", ec);
+  // Temporaries of a killed run: "<output>.tmp-<pid>".
+  std::vector<fs::path> stale;
+  for (const auto& e : fs::directory_iterator(out, ec)) {
+    const std::string n = e.path().filename().string();
+    for (const auto& name : runOutputFiles())
+      if (n.rfind(name + ".tmp-", 0) == 0) stale.push_back(e.path());
+  }
+  for (const auto& p : stale) fs::remove(p, ec);
+}
 
 double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -83,6 +117,26 @@ void evaluate(const std::string& data_dir, const std::string& out, Report& repor
 
 }  // namespace
 
+void installRunInterruptHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onRunInterrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int runInterruptSignal() { return g_interrupt_signal; }
+
+void requestRunInterrupt(int sig) { g_interrupt_signal = sig; }
+
+const std::vector<std::string>& runOutputFiles() {
+  // report.json first: while the others are removed, no report claims them.
+  static const std::vector<std::string> files{"report.json",    "config.json", "trajectory.tum", "keyframes.tum",
+                                              "states.csv",     "points.ply",  "diagnostics.bin", "index.html"};
+  return files;
+}
+
 nlohmann::json loadRunConfig(const std::string& path, const std::vector<std::string>& sets, PluginHost& host) {
   nlohmann::json raw = loadConfigWithSets(path, sets);
   return validateConfig(raw, runConfigSchema(), host, path, sets);  // problems of a --set blame it
@@ -104,6 +158,9 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   std::error_code ec;
   fs::create_directories(request.out_dir, ec);
   if (ec) throw Error(request.out_dir + ": cannot create output folder: " + ec.message());
+  if (!fs::is_directory(request.out_dir, ec))
+    throw Error(request.out_dir + ": cannot create output folder: a file of that name exists");
+  cleanRunFolder(request.out_dir);
   writeConfig(cfg, (fs::path(request.out_dir) / "config.json").string());
   const SensorSetup& sensors = source->sensors();
 
@@ -124,7 +181,15 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(sensors.camera.time_offset_s);
   auto last_print = Clock::now();
   long processed = 0;
+  auto interrupted = [&] {
+    if (runInterruptSignal() == 0) return false;
+    report.status = "interrupted";
+    report.error = std::string("interrupted by ") + (runInterruptSignal() == SIGTERM ? "SIGTERM" : "SIGINT") +
+                   " after " + std::to_string(processed) + " of " + std::to_string(n) + " frames";
+    return true;
+  };
   for (size_t i = 0; i < n && !odo.failed(); ++i) {
+    if (interrupted()) break;
     const int64_t t_f = source->frameTime(i);
     while (imu_next < imu.size() && imu[imu_next].t_ns <= t_f + lookahead_ns) odo.addImu(imu[imu_next++]);
     Frame frame;
@@ -154,9 +219,10 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
       last_print = Clock::now();
     }
   }
+  if (report.status == "ok") interrupted();  // a signal during the last frame
   if (!odo.failed() && report.status == "ok") odo.finish();
   const double wall = secondsSince(t_start);
-  if (odo.failed()) {
+  if (odo.failed() && report.status != "interrupted") {
     report.status = "failed";
     report.error = odo.failureReason();
   }

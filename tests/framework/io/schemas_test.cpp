@@ -72,7 +72,7 @@ TEST(ReportSchema, RoundTrip) {
 TEST(ReportSchema, BadFilesNamed) {
   const auto path = tmpFile("bad_report.json");
   std::ofstream(path) << "{\"status\": \"maybe\"}";
-  EXPECT_NE(errorOf([&] { Report::read(path); }).find("status: expected \"ok\" or \"failed\""), std::string::npos);
+  EXPECT_NE(errorOf([&] { Report::read(path); }).find("status: expected \"ok\", \"failed\" or \"interrupted\""), std::string::npos);
   std::ofstream(path) << "{not json";
   EXPECT_NE(errorOf([&] { Report::read(path); }).find(path + ": invalid JSON"), std::string::npos);
   fs::remove(path);

@@ -8,6 +8,17 @@
 // dataset, with status "failed" and the error when the run fails; what was estimated before the failure
 // is still written.
 //
+// Interrupts (user-contract.md, exit code 130): after installRunInterruptHandlers(), the first SIGINT or
+// SIGTERM asks the run to stop at the next frame: the frame loop ends, everything estimated so far is
+// written as after a normal end and report.json says status "interrupted" with the signal in "error".
+// A second signal of either kind ends the process at once (default action). Every output file is
+// written atomically (io/atomic_file.h) and report.json last, so even SIGKILL at any moment never leaves
+// a report.json beside truncated files; a report.json saying "ok" means every file beside it is complete.
+//
+// Clean folder: a run removes the files an earlier run left in out_dir (the contract files above,
+// render outputs index.html and figures/, stale temporaries) before writing anything, report.json
+// first, so no stale file outlives its run. Other files in out_dir are left alone.
+//
 // IMU feeding: before frame f (stamp t_f, camera clock) the odometry receives every IMU sample with
 // t_imu <= t_f + time_offset + half a frame period, so a rolling-shutter frame's whole readout is covered.
 #pragma once
@@ -32,7 +43,7 @@ struct RunRequest {
 };
 
 struct RunResult {
-  Report report;
+  Report report;                   // status "ok", "failed" or "interrupted"
   nlohmann::json effective_config;
   std::string out_dir;
 };
@@ -44,5 +55,15 @@ nlohmann::json loadRunConfig(const std::string& path, const std::vector<std::str
 // is open (bad config, unreadable dataset); later failures (divergence, a missing image mid-sequence)
 // end in report.status == "failed" with the reason, and are returned, not thrown.
 RunResult runPipeline(const RunRequest& request, PluginHost& host);
+
+// SIGINT/SIGTERM handlers for the process (see "Interrupts" above); `rsvio run` installs them.
+void installRunInterruptHandlers();
+// The signal that asked the run to stop (0: none yet).
+int runInterruptSignal();
+// Asks a run in progress (or the next one) to stop as a signal would; sig = 0 clears the request.
+void requestRunInterrupt(int sig);
+
+// The files a run writes into its folder (and removes there before it starts).
+const std::vector<std::string>& runOutputFiles();
 
 }  // namespace rsvio
