@@ -1,12 +1,19 @@
 // rsvio compare: run every (config, dataset, run) as a child `rsvio run` in a bounded pool of worker
 // processes and tabulate ATE, failures and fps (framework: rsvio/eval/compare.h; docs/eval.md).
 // Exit code: 0 when every run is ok, 1 when at least one failed (the table and files are still
-// written), 2 for a usage or setup error (missing config or dataset, unwritable --out).
+// written), 2 for a usage or setup error (missing config or dataset, unwritable --out), 130 when stopped
+// by SIGINT/SIGTERM: the running children get SIGTERM (they stop at their next frame and keep their
+// outputs), the table of the runs finished so far is written, and `--resume` finishes the grid later
+// (finished runs are kept, matched by config hash, dataset and seed). A second signal kills the children.
+#include <signal.h>
+
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "commands.h"
+#include "rsvio/config/config.h"
 #include "rsvio/core/error.h"
 #include "rsvio/eval/compare.h"
 #ifdef RSVIO_HAVE_VIZ
@@ -16,8 +23,24 @@
 namespace rsvio::app {
 namespace {
 
+volatile std::sig_atomic_t g_compare_signals = 0;
+
+extern "C" void onCompareSignal(int) {
+  if (g_compare_signals < 2) g_compare_signals = g_compare_signals + 1;
+}
+
+void installCompareSignalHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onCompareSignal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
 struct CompareArgs {
-  std::vector<std::string> configs, datasets;
+  std::vector<std::string> configs, datasets, sets;
+  bool resume = false;
   int runs = 1;
   int jobs = 2;
   double timeout_s = 3600;
@@ -31,6 +54,7 @@ void renderFigures(const CompareArgs& a, const eval::CompareResult& result, int 
 #ifdef RSVIO_HAVE_VIZ
   std::vector<viz::CompareRun> runs;
   for (const auto& x : result.runs) {
+    if (x.status == "interrupted" || x.status == "not run") continue;
     viz::CompareRun c;
     c.config = x.job.config_name;
     c.sequence = x.job.dataset_name;
@@ -71,7 +95,10 @@ int runCompareCommand(const CompareArgs& a, const GlobalOptions& g) {
   for (const auto& d : a.datasets) {
     if (!fs::is_directory(d)) throw ConfigError("--data: " + d + ": no such folder");
   }
-  const auto jobs = eval::planCompareJobs(a.configs, a.datasets, a.runs, a.out);
+  // A --set that cannot apply is the grid's usage error, not a failure of every run.
+  if (!a.sets.empty())
+    for (const auto& c : a.configs) (void)loadConfigWithSets(c, a.sets);
+  const auto jobs = eval::planCompareJobs(a.configs, a.datasets, a.runs, a.out, a.sets);
   eval::RunArgvBuilder builder;
   if (!a.runner.empty()) {
     builder = [runner = a.runner](const eval::CompareJob& j) { return eval::rsvioRunArgv(runner, {}, j); };
@@ -83,6 +110,9 @@ int runCompareCommand(const CompareArgs& a, const GlobalOptions& g) {
   eval::CompareOptions opt;
   opt.jobs = a.jobs;
   opt.timeout_s = a.timeout_s;
+  opt.resume = a.resume;
+  opt.stop_level = [] { return static_cast<int>(g_compare_signals); };
+  installCompareSignalHandlers();
   if (g.verbosity > 0) {
     std::cout << "rsvio compare: " << jobs.size() << " runs (" << a.configs.size() << " configs x " << a.datasets.size()
               << " datasets x " << a.runs << " seeds), " << a.jobs << " at a time, into " << a.out << "/runs\n";
@@ -95,11 +125,17 @@ int runCompareCommand(const CompareArgs& a, const GlobalOptions& g) {
     return out;
   };
   const nlohmann::json invocation = {{"configs", absolute(a.configs)}, {"data", absolute(a.datasets)},
-                                     {"runs", a.runs}, {"jobs", a.jobs}, {"timeout_s", a.timeout_s}};
+                                     {"runs", a.runs}, {"jobs", a.jobs}, {"timeout_s", a.timeout_s},
+                                     {"sets", a.sets}};
   eval::writeCompareOutputs(a.out, result, invocation);
   std::cout << "\n" << eval::formatCompareTable(result);
   std::cout << "written: " << (fs::path(a.out) / "compare.csv").string() << ", "
             << (fs::path(a.out) / "compare.json").string() << "\n";
+  if (result.interrupted) {
+    std::cerr << "rsvio compare: interrupted: " << result.unfinished()
+              << " runs not finished; the same command with --resume finishes the grid\n";
+    return 130;
+  }
   if (!a.no_figures) renderFigures(a, result, g.verbosity);
   return result.failed() == 0 ? 0 : 1;
 }
@@ -111,6 +147,9 @@ void addCompareCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r)
   auto* sub = root.add_subcommand("compare", "run configs x datasets x seeds in parallel and tabulate ATE, failures, fps");
   sub->add_option("--configs", args->configs, "config files (JSON)")->required();
   sub->add_option("--data", args->datasets, "dataset folders (EuRoC layout)")->required();
+  sub->add_option("--set", args->sets, "override a config key in every config of the grid: a.b.c=value")->take_all();
+  sub->add_flag("--resume", args->resume,
+                "keep the finished runs of an earlier invocation into --out (same config, data, seed) and run the rest");
   sub->add_option("--runs", args->runs, "runs per (config, dataset); run k uses --seed k")->capture_default_str();
   sub->add_option("--jobs", args->jobs, "worker processes at once")->capture_default_str();
   sub->add_option("--timeout-s", args->timeout_s, "a run longer than this is killed and counted as failed (0: none)")

@@ -9,9 +9,12 @@
 #include <map>
 #include <ostream>
 #include <set>
+#include <csignal>
 
+#include "rsvio/config/config.h"
 #include "rsvio/core/error.h"
 #include "rsvio/eval/evaluate_files.h"
+#include "rsvio/io/atomic_file.h"
 #include "rsvio/io/trajectory.h"
 
 namespace rsvio::eval {
@@ -102,6 +105,8 @@ std::string progressLine(size_t done, size_t total, const RunRecord& r) {
   std::snprintf(buf, sizeof(buf), "[%zu/%zu] %s on %s run %d: ", done, total, r.job.config_name.c_str(),
                 r.job.dataset_name.c_str(), r.job.run);
   std::string s = buf;
+  if (r.status == "interrupted" || r.status == "not run") return s + r.status + " (" + r.error + ")";
+  if (r.kept) s = s + "kept from the earlier comparison, ";
   if (!r.ok) return s + "FAILED (" + r.error + ")";
   s += "ok";
   if (r.ate_rmse_m) {
@@ -117,10 +122,75 @@ std::string progressLine(size_t done, size_t total, const RunRecord& r) {
   return s;
 }
 
+std::string fnv1a(const std::string& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string configHash(const std::string& path, const std::vector<std::string>& sets) {
+  try {
+    return fnv1a(loadConfigWithSets(path, sets).dump());
+  } catch (const std::exception&) {
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (const auto& x : sets) bytes += "\n--set " + x;
+    return fnv1a(bytes);
+  }
+}
+
+std::string absolutePath(const std::string& p) {
+  std::error_code ec;
+  auto a = fs::absolute(p, ec);
+  return ec ? p : a.lexically_normal().string();
+}
+
+// --resume: the record of an earlier invocation's finished run, when its job.json matches this job.
+std::optional<RunRecord> keptRun(const CompareJob& job) {
+  const fs::path dir(job.out_dir);
+  std::error_code ec;
+  if (!fs::is_regular_file(dir / "job.json", ec) || !fs::is_regular_file(dir / "report.json", ec)) return std::nullopt;
+  std::ifstream jin(dir / "job.json");
+  const auto id = nlohmann::json::parse(jin, nullptr, false);
+  if (id.is_discarded() || id != jobIdentity(job)) return std::nullopt;
+  std::ifstream rin(dir / "report.json");
+  const auto rep = nlohmann::json::parse(rin, nullptr, false);
+  if (rep.is_discarded() || !rep.is_object()) return std::nullopt;
+  const std::string status = stringAt(rep, "status");
+  if (status != "ok" && status != "failed") return std::nullopt;
+  ChildOutcome oc;
+  oc.kind = ChildOutcome::Kind::kExited;
+  oc.code = status == "ok" ? 0 : 1;
+  RunRecord r = collectRun(job, oc);
+  r.kept = true;
+  return r;
+}
+
 }  // namespace
 
+nlohmann::json jobIdentity(const CompareJob& job) {
+  return {{"config", absolutePath(job.config_path)}, {"config_hash", job.config_hash},
+          {"data", absolutePath(job.dataset_dir)},   {"seed", job.run},
+          {"sets", job.sets}};
+}
+
+size_t CompareResult::unfinished() const {
+  return static_cast<size_t>(std::count_if(runs.begin(), runs.end(), [](const RunRecord& r) {
+    return r.status == "interrupted" || r.status == "not run";
+  }));
+}
+
+size_t CompareResult::kept() const {
+  return static_cast<size_t>(std::count_if(runs.begin(), runs.end(), [](const RunRecord& r) { return r.kept; }));
+}
+
 std::vector<CompareJob> planCompareJobs(const std::vector<std::string>& configs, const std::vector<std::string>& datasets,
-                                        int runs, const std::string& out_root) {
+                                        int runs, const std::string& out_root, const std::vector<std::string>& sets) {
   std::vector<std::string> cfg_raw, ds_raw;
   for (const auto& c : configs) cfg_raw.push_back(fs::path(c).stem().string());
   for (const auto& d : datasets) {
@@ -131,6 +201,7 @@ std::vector<CompareJob> planCompareJobs(const std::vector<std::string>& configs,
   const auto cfg_names = uniqueNames(cfg_raw), ds_names = uniqueNames(ds_raw);
   std::vector<CompareJob> jobs;
   for (size_t c = 0; c < configs.size(); ++c) {
+    const std::string hash = configHash(configs[c], sets);
     for (size_t d = 0; d < datasets.size(); ++d) {
       for (int k = 0; k < runs; ++k) {
         CompareJob j;
@@ -139,6 +210,8 @@ std::vector<CompareJob> planCompareJobs(const std::vector<std::string>& configs,
         j.dataset_dir = datasets[d];
         j.dataset_name = ds_names[d];
         j.run = k;
+        j.sets = sets;
+        j.config_hash = hash;
         j.out_dir = (fs::path(out_root) / "runs" / j.config_name / j.dataset_name / std::to_string(k)).string();
         jobs.push_back(j);
       }
@@ -155,6 +228,10 @@ std::vector<std::string> rsvioRunArgv(const std::string& program, const std::vec
                                job.dataset_dir, std::string("--out"), job.out_dir, std::string("--seed"),
                                std::to_string(job.run)}) {
     argv.push_back(a);
+  }
+  for (const auto& x : job.sets) {
+    argv.push_back("--set");
+    argv.push_back(x);
   }
   return argv;
 }
@@ -176,6 +253,20 @@ RunRecord collectRun(const CompareJob& job, const ChildOutcome& outcome) {
     } else {
       report = std::move(j);
     }
+  }
+  if (outcome.kind == ChildOutcome::Kind::kNotStarted) {
+    r.status = "not run";
+    r.error = outcome.describe();
+    return r;
+  }
+  const std::string rep_status = report ? stringAt(*report, "status") : "";
+  if (rep_status == "interrupted" || (outcome.kind == ChildOutcome::Kind::kExited && outcome.code == 130) ||
+      (outcome.kind == ChildOutcome::Kind::kSignaled && (outcome.code == SIGTERM || outcome.code == SIGKILL ||
+                                                         outcome.code == SIGINT) && outcome.stopped)) {
+    r.status = "interrupted";
+    const std::string rep_error = report ? stringAt(*report, "error") : "";
+    r.error = rep_error.empty() ? outcome.describe() : rep_error;
+    return r;
   }
   if (!outcome.ok()) {
     std::string why = outcome.describe();
@@ -201,6 +292,7 @@ RunRecord collectRun(const CompareJob& job, const ChildOutcome& outcome) {
     return r;
   }
   r.ok = true;
+  r.status = "ok";
   r.fps = numberAt(*report, "fps");
   r.realtime_factor = numberAt(*report, "realtime_factor");
   const nlohmann::json ev = report->contains("eval") ? (*report)["eval"] : nlohmann::json();
@@ -215,7 +307,8 @@ RunRecord collectRun(const CompareJob& job, const ChildOutcome& outcome) {
 }
 
 size_t CompareResult::failed() const {
-  return static_cast<size_t>(std::count_if(runs.begin(), runs.end(), [](const RunRecord& r) { return !r.ok; }));
+  return static_cast<size_t>(
+      std::count_if(runs.begin(), runs.end(), [](const RunRecord& r) { return r.status == "failed"; }));
 }
 
 std::vector<GroupSummary> summariseRuns(const std::vector<RunRecord>& runs) {
@@ -223,6 +316,7 @@ std::vector<GroupSummary> summariseRuns(const std::vector<RunRecord>& runs) {
   std::map<std::pair<std::string, std::string>, size_t> index;
   std::vector<std::vector<double>> ates, fpss;
   for (const auto& r : runs) {
+    if (r.status == "interrupted" || r.status == "not run") continue;  // the summary is of finished runs
     const auto key = std::make_pair(r.job.config_name, r.job.dataset_name);
     auto it = index.find(key);
     if (it == index.end()) {
@@ -259,22 +353,41 @@ std::vector<GroupSummary> summariseRuns(const std::vector<RunRecord>& runs) {
 
 CompareResult runCompare(const std::vector<CompareJob>& jobs, const RunArgvBuilder& argv_builder,
                          const CompareOptions& options, std::ostream* progress) {
+  CompareResult res;
+  res.runs.resize(jobs.size());
+  size_t done = 0;
   std::vector<ChildSpec> specs;
-  for (const auto& j : jobs) {
+  std::vector<size_t> spec_job;  // job index of each spec
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    const auto& j = jobs[i];
+    if (options.resume) {
+      if (auto kept = keptRun(j)) {
+        res.runs[i] = *kept;
+        ++done;
+        if (progress) *progress << progressLine(done, jobs.size(), res.runs[i]) << std::endl;
+        continue;
+      }
+    }
     // A folder left by an earlier comparison must not lend its report.json to this run.
     std::error_code ec;
     fs::remove_all(j.out_dir, ec);
     fs::create_directories(j.out_dir, ec);
     if (ec) throw Error(j.out_dir + ": cannot create the run folder (" + ec.message() + ")");
+    const std::string id = jobIdentity(j).dump(2) + "\n";
+    io::writeFileAtomic((fs::path(j.out_dir) / "job.json").string(), [&](std::ostream& o) { o << id; }, "job");
     specs.push_back({argv_builder(j), (fs::path(j.out_dir) / "log.txt").string()});
+    spec_job.push_back(i);
   }
-  CompareResult res;
-  res.runs.resize(jobs.size());
-  size_t done = 0;
   PoolOptions pool;
   pool.max_workers = options.jobs;
   pool.timeout_s = options.timeout_s;
-  runChildProcesses(specs, pool, {}, [&](size_t i, const ChildOutcome& oc) {
+  pool.stop_level = [&]() {
+    const int level = options.stop_level ? options.stop_level() : 0;
+    if (level > 0) res.interrupted = true;
+    return level;
+  };
+  runChildProcesses(specs, pool, {}, [&](size_t k, const ChildOutcome& oc) {
+    const size_t i = spec_job[k];
     res.runs[i] = collectRun(jobs[i], oc);
     ++done;
     if (progress) *progress << progressLine(done, jobs.size(), res.runs[i]) << std::endl;

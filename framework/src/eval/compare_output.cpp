@@ -6,6 +6,7 @@
 
 #include "rsvio/core/error.h"
 #include "rsvio/eval/compare.h"
+#include "rsvio/io/atomic_file.h"
 
 namespace rsvio::eval {
 namespace {
@@ -54,8 +55,10 @@ std::string formatCompareTable(const CompareResult& r) {
                   g.dataset_name.c_str(), g.runs, g.failed, med.c_str(), mn.c_str(), fps.c_str());
     o << buf;
   }
-  o << r.runs.size() - r.failed() << " of " << r.runs.size() << " runs ok";
+  o << r.runs.size() - r.failed() - r.unfinished() << " of " << r.runs.size() << " runs ok";
   if (r.failed()) o << ", " << r.failed() << " failed (errors in compare.json / compare.csv, logs in runs/*/*/*/log.txt)";
+  if (r.unfinished()) o << ", " << r.unfinished() << " not finished (interrupted; rerun with --resume to finish them)";
+  if (r.kept()) o << "; " << r.kept() << " kept from the earlier comparison (--resume)";
   o << "\n";
   return o.str();
 }
@@ -82,7 +85,8 @@ nlohmann::json compareToJson(const CompareResult& r) {
                     {"dataset_dir", x.job.dataset_dir},
                     {"run", x.job.run},
                     {"seed", x.job.run},
-                    {"status", x.ok ? "ok" : "failed"},
+                    {"status", x.status},
+                    {"kept", x.kept},
                     {"error", x.error},
                     {"ate_rmse_m", jnum(x.ate_rmse_m)},
                     {"align", x.align},
@@ -93,7 +97,8 @@ nlohmann::json compareToJson(const CompareResult& r) {
                     {"out_dir", x.job.out_dir},
                     {"log", x.log_path}});
   }
-  return {{"runs_total", r.runs.size()}, {"failed", r.failed()}, {"summary", summary}, {"runs", runs}};
+  return {{"runs_total", r.runs.size()}, {"failed", r.failed()},   {"unfinished", r.unfinished()},
+          {"interrupted", r.interrupted}, {"summary", summary},     {"runs", runs}};
 }
 
 void writeCompareOutputs(const std::string& out_dir, const CompareResult& r, const nlohmann::json& invocation) {
@@ -101,14 +106,12 @@ void writeCompareOutputs(const std::string& out_dir, const CompareResult& r, con
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   const std::string json_path = (fs::path(out_dir) / "compare.json").string();
-  {
-    std::ofstream f(json_path);
-    nlohmann::json j = compareToJson(r);
-    if (!invocation.is_null()) j["invocation"] = invocation;
-    if (!(f << j.dump(2) << "\n")) throw Error(json_path + ": cannot write");
-  }
+  nlohmann::json j = compareToJson(r);
+  if (!invocation.is_null()) j["invocation"] = invocation;
+  const std::string json_text = j.dump(2) + "\n";
+  io::writeFileAtomic(json_path, [&](std::ostream& f) { f << json_text; }, "comparison");
   const std::string csv_path = (fs::path(out_dir) / "compare.csv").string();
-  std::ofstream f(csv_path);
+  io::writeFileAtomic(csv_path, [&](std::ostream& f) {
   // Summary rows fill the columns up to fps_mean, run rows those from ate_rmse_m on.
   f << "row,config,dataset,run,status,runs,failed,ate_median_m,ate_mean_m,fps_median,fps_mean,"
        "ate_rmse_m,fps,realtime_factor,align,error\n";
@@ -119,10 +122,10 @@ void writeCompareOutputs(const std::string& out_dir, const CompareResult& r, con
   }
   for (const auto& x : r.runs) {
     f << "run," << csvField(x.job.config_name) << "," << csvField(x.job.dataset_name) << "," << x.job.run << ","
-      << (x.ok ? "ok" : "failed") << ",,,,,,," << num(x.ate_rmse_m, "%.9g") << "," << num(x.fps, "%.6g") << ","
+      << x.status << ",,,,,,," << num(x.ate_rmse_m, "%.9g") << "," << num(x.fps, "%.6g") << ","
       << num(x.realtime_factor, "%.6g") << "," << csvField(x.align) << "," << csvField(x.error) << "\n";
   }
-  if (!f) throw Error(csv_path + ": cannot write");
+  }, "comparison table");
 }
 
 }  // namespace rsvio::eval

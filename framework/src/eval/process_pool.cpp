@@ -46,14 +46,33 @@ pid_t spawnChild(const ChildSpec& spec, std::string& error) {
   argv.reserve(spec.argv.size() + 1);
   for (const auto& a : spec.argv) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
+  // Own process group: a Ctrl-C on the terminal goes to the parent only, which stops the children.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setpgroup(&attr, 0);
+  // Default dispositions and an empty mask for SIGINT/SIGTERM, whatever the parent installed.
+  sigset_t def, empty;
+  sigemptyset(&def);
+  sigaddset(&def, SIGINT);
+  sigaddset(&def, SIGTERM);
+  sigemptyset(&empty);
+  posix_spawnattr_setsigdefault(&attr, &def);
+  posix_spawnattr_setsigmask(&attr, &empty);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
   pid_t pid = -1;
-  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, argv[0], &fa, &attr, argv.data(), environ);
+  posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0) {
     error = std::strerror(rc);
     return -1;
   }
   return pid;
+}
+
+// The child and whatever it started (it leads its own process group).
+void signalGroup(pid_t pid, int sig) {
+  if (kill(-pid, sig) != 0) kill(pid, sig);
 }
 
 }  // namespace
@@ -70,6 +89,7 @@ std::string ChildOutcome::describe() const {
       std::snprintf(buf, sizeof(buf), "timed out after %g s (killed)", timeout_s);
       return buf;
     }
+    case Kind::kNotStarted: return "not started (interrupted)";
     default: return "could not start: " + spawn_error;
   }
 }
@@ -86,7 +106,20 @@ std::vector<ChildOutcome> runChildProcesses(const std::vector<ChildSpec>& childr
     outcomes[i] = o;
     if (on_done) on_done(i, outcomes[i]);
   };
+  int stop_sent = 0;  // the stop level already acted on
   while (next < children.size() || !running.empty()) {
+    const int level = options.stop_level ? options.stop_level() : 0;
+    if (level > stop_sent) {
+      for (const Running& r : running) signalGroup(r.pid, level >= 2 ? SIGKILL : SIGTERM);
+      stop_sent = level;
+    }
+    if (stop_sent > 0) {
+      while (next < children.size()) {
+        ChildOutcome o;
+        o.kind = ChildOutcome::Kind::kNotStarted;
+        finish(next++, o);
+      }
+    }
     while (next < children.size() && running.size() < max_workers) {
       const size_t i = next++;
       if (on_start) on_start(i);
@@ -122,13 +155,14 @@ std::vector<ChildOutcome> runChildProcesses(const std::vector<ChildSpec>& childr
         o.kind = ChildOutcome::Kind::kSpawnFailed;
         o.spawn_error = std::string("lost track of the child: ") + std::strerror(errno);
       } else if (options.timeout_s > 0 && secondsSince(it->start) > options.timeout_s) {
-        kill(it->pid, SIGKILL);
+        signalGroup(it->pid, SIGKILL);
         waitpid(it->pid, &status, 0);
         done = true;
         o.kind = ChildOutcome::Kind::kTimedOut;
       }
       if (done) {
         o.wall_s = secondsSince(it->start);
+        o.stopped = stop_sent > 0;
         const size_t i = it->index;
         it = running.erase(it);
         finish(i, o);

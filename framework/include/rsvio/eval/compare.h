@@ -13,6 +13,14 @@
 //   eval/evaluate_files.h and the default alignment for its frame (as the paper's eq. 35: keyframes).
 // - Summary per (config, dataset): runs, failed, median and mean ATE over ok runs with an ATE, median
 //   and mean fps over ok runs. Failed runs never enter the ATE statistics; they are counted.
+// - Interrupt (CompareOptions::stop_level, set by `rsvio compare` from SIGINT/SIGTERM): running children
+//   get SIGTERM (an `rsvio run` stops at its next frame, writes its outputs, exits 130), no more start;
+//   their records say "interrupted" / "not run" and stay out of the summary, which covers the finished
+//   runs. A second signal kills the children (SIGKILL).
+// - Resume (CompareOptions::resume): each run folder holds job.json (config hash, dataset, seed, --set
+//   values), written before its child starts. A run whose job.json matches its job and whose report.json
+//   says "ok" or "failed" is kept as it is; every other run folder is emptied and the run is started
+//   again. The config hash is over the effective config (extends and --set applied).
 // - The child command is injectable (RunArgvBuilder), so the scheduler and the aggregation are tested
 //   with fake children.
 #pragma once
@@ -32,21 +40,30 @@ struct CompareJob {
   std::string dataset_dir, dataset_name;   // name: folder name, made unique and path-safe
   int run = 0;                             // also the seed
   std::string out_dir;                     // <out>/runs/<config_name>/<dataset_name>/<run>
+  std::vector<std::string> sets;           // --set values given to every run
+  std::string config_hash;                 // FNV-1a 64 of the effective config (hex); of the file's bytes
+                                           // when it does not load
 };
 
 // Order: config, then dataset, then run.
 std::vector<CompareJob> planCompareJobs(const std::vector<std::string>& configs, const std::vector<std::string>& datasets,
-                                        int runs, const std::string& out_root);
+                                        int runs, const std::string& out_root,
+                                        const std::vector<std::string>& sets = {});
+
+// job.json of a run folder: what identifies the run for --resume.
+nlohmann::json jobIdentity(const CompareJob& job);
 
 using RunArgvBuilder = std::function<std::vector<std::string>(const CompareJob&)>;
 
-// [program, pre_args..., "run", "--config", C, "--data", D, "--out", O, "--seed", k]
+// [program, pre_args..., "run", "--config", C, "--data", D, "--out", O, "--seed", k, ("--set", s)...]
 std::vector<std::string> rsvioRunArgv(const std::string& program, const std::vector<std::string>& pre_args,
                                       const CompareJob& job);
 
 struct RunRecord {
   CompareJob job;
   bool ok = false;
+  std::string status = "failed";     // "ok", "failed", "interrupted" (stopped part way), "not run"
+  bool kept = false;                 // --resume: the finished run of an earlier invocation
   std::string error;                 // empty when ok
   std::string eval_note;             // where the ATE came from, or why there is none
   std::optional<double> ate_rmse_m;
@@ -68,12 +85,17 @@ struct GroupSummary {
 struct CompareOptions {
   int jobs = 2;
   double timeout_s = 3600;
+  bool resume = false;
+  std::function<int()> stop_level;   // see process_pool.h: 0 run on, 1 stop, 2 kill
 };
 
 struct CompareResult {
   std::vector<RunRecord> runs;       // in job order
-  std::vector<GroupSummary> groups;  // in (config, dataset) order of first appearance
-  size_t failed() const;
+  std::vector<GroupSummary> groups;  // finished runs only, in (config, dataset) order of first appearance
+  bool interrupted = false;          // stop_level was raised: some runs are "interrupted" or "not run"
+  size_t failed() const;             // status "failed"
+  size_t unfinished() const;         // status "interrupted" or "not run"
+  size_t kept() const;               // kept from an earlier invocation (--resume)
 };
 
 std::vector<GroupSummary> summariseRuns(const std::vector<RunRecord>& runs);
