@@ -256,6 +256,6 @@ long Odometry::numKeyframes() const { return static_cast<long>(impl_->keyframes.
 bool Odometry::usesImu() const { return false; }
 double Odometry::scale() const { return 1.0; }
 std::vector<std::string> Odometry::warnings() const { return impl_->warnings; }
-DiagnosticsLog Odometry::diagnostics() const { return impl_->diag; }
+const DiagnosticsLog& Odometry::diagnostics() const { return impl_->diag; }
 
 }  // namespace rsvio

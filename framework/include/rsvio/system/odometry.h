@@ -60,7 +60,7 @@ class Odometry {
   io::Trajectory keyframeTrajectory() const;  // keyframes after their last optimisation
   std::vector<MapPoint> points() const;
   std::vector<StateRow> states() const;
-  DiagnosticsLog diagnostics() const;
+  const DiagnosticsLog& diagnostics() const;  // a reference: the log grows with the run (no copy to write it)
   std::map<std::string, double> stageMs() const;  // mean ms per call of each stage
   long numKeyframes() const;
   bool usesImu() const;
