@@ -37,6 +37,11 @@ int runRender(const RenderArgs& a, int verbosity) {
       snap.states.empty())
     throw DataError(a.run + ": nothing to draw: no report.json, trajectory.tum, keyframes.tum, points.ply or "
                             "states.csv (is this a folder written by rsvio run?)");
+  // A folder that cannot be made (under a file, read-only) is bad input: said before drawing anything.
+  const std::filesystem::path fig_dir = a.out.empty() ? std::filesystem::path(a.run) / "figures" : std::filesystem::path(a.out);
+  std::error_code ec;
+  std::filesystem::create_directories(fig_dir, ec);
+  if (ec) throw Error(fig_dir.string() + ": cannot create the figure folder (" + ec.message() + ")");
   viz::RenderOptions o;
   o.out_dir = a.out;
   if (!a.out.empty()) o.index_path = (std::filesystem::path(a.out) / "index.html").string();

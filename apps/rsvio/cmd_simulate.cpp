@@ -2,12 +2,14 @@
 // Writes a synthetic rolling-shutter visual-inertial dataset in the EuRoC/ASL layout plus truth.json
 // (framework/include/rsvio/sim/simulator.h). Progress goes to stderr; a one-line summary at the end.
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <unistd.h>
 
 #include "commands.h"
+#include "rsvio/core/error.h"
 #include "rsvio/plugin/host.h"
 #include "rsvio/sim/simulator.h"
 
@@ -29,6 +31,10 @@ int runSimulate(const SimulateOptions& o, const GlobalOptions& g) {
   if (o.threads > 0) sets.push_back("threads=" + std::to_string(o.threads));
   const std::optional<int64_t> seed = o.seed >= 0 ? std::optional<int64_t>(o.seed) : std::nullopt;
   const nlohmann::json effective = sim::loadSimConfig(o.config, sets, seed, host);
+  // The output folder first: one that cannot be made is said before any progress line.
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec) throw Error(o.out + ": cannot create output folder (" + ec.message() + ")");
   sim::Simulator simulator(effective, host);
   const auto& s = simulator.settings();
   if (g.verbosity > 0) {
