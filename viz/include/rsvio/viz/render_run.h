@@ -9,7 +9,7 @@
 //   (no X display and no Xvfb): the page then says why the 3D views are missing.
 // - Files of a run (defaults): <run>/figures/*.png and <run>/index.html, links relative so the folder
 //   can be moved or served as is.
-//   figures: trajectory_{top,side,perspective}.png (VTK), trajectory_plan.png, error_over_time.png,
+//   figures: trajectory_{top,side,perspective,overview}.png (VTK), trajectory_plan.png, error_over_time.png,
 //   states.png, residual_row_time.png and residual_image.png (when diagnostics.bin is there).
 // - Files of a comparison: <out>/figures/compare_grid.png, ate_per_config.png, <out>/index.html.
 #pragma once
