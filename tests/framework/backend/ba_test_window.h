@@ -28,8 +28,10 @@ struct TestWindow {
 
   // n keyframes moving sideways and forward with small rotations; twists (per second) when rolling.
   // twist_scale multiplies the per-keyframe twists (rolling shutter: a stronger readout distortion).
+  // smooth_twists: every twist is the poses' own constant velocity (the keyframes lie on one
+  // constant-twist motion, 0.1 s apart), as the smooth-motion term assumes.
   explicit TestWindow(int n, bool rolling = false, double line_delay_s = 0.0, double twist_scale = 1.0,
-                      double texel_m = 0.012) {
+                      double texel_m = 0.012, bool smooth_twists = false) {
     if (texel_m != 0.012) {
       const Eigen::Vector3d X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
       scene.setPlanes({{Eigen::Vector3d(-3, -3, 4.0), X, Y, texel_m, 0},
@@ -42,6 +44,7 @@ struct TestWindow {
       KeyframeState s;
       s.T_c_w = SE3d::exp(tw(-0.12 * i, 0.02 * i, -0.05 * i, 0.01 * i, -0.02 * i, 0.005 * i));
       if (rolling) s.twist = twist_scale * tw(0.6 - 0.1 * i, 0.2, 0.3, 0.3, -0.5 + 0.1 * i, 0.2);
+      if (rolling && smooth_twists) s.twist = tw(-0.12, 0.02, -0.05, 0.01, -0.02, 0.005) / 0.1;
       truth.push_back(s);
       auto kf = std::make_unique<Keyframe>();
       kf->frame_index = 10 * i;
