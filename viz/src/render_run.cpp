@@ -185,9 +185,11 @@ RenderStatus renderRun(const io::Snapshot& s, const RenderOptions& o) {
       attempt("states.png", st, [&] {
         const auto path = out / "states.png";
         std::vector<std::string> missing;
-        const auto panels = keyframeStatePanels(s.states, std::isfinite(s.summary.scale), &missing);
+        auto panels = keyframeStatePanels(s.states, std::isfinite(s.summary.scale), &missing);
         std::string not_est;
         for (const auto& m : missing) not_est += (not_est.empty() ? "" : ", ") + m;
+        // The figure itself says what has no panel, not only the page's caption.
+        if (!panels.empty() && !not_est.empty()) panels.back().x_label += "      (not estimated, no panel: " + not_est + ")";
         std::string shown;
         for (const auto& p : panels) shown += (shown.empty() ? "" : ", ") + p.title;
         // About 0.4 of a figure's height per panel (at least one figure high).
