@@ -276,6 +276,18 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
   }
   nlohmann::json ranking, na;
   evaluateAll(run.log, run.config, host, ranking, na);
+  // A model that can refine the value the line sets (online estimation) is told to: e.g.
+  // shutter.rolling's estimate_line_delay, when the installed plugin has that parameter.
+  for (auto& e : ranking) {
+    if (e["plugin"] == "shutter.rolling") {
+      try {
+        for (const auto& p : host.info("shutter.rolling").params)
+          if (p.key == "estimate_line_delay")
+            e["config_line"] = e["config_line"].get<std::string>() + " --set shutter.params.estimate_line_delay=true";
+      } catch (const std::exception&) {
+      }
+    }
+  }
   d["verdict"] = effectOf(ranking);
   d["ranking"] = ranking;
   d["not_applicable"] = na;
