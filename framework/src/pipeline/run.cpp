@@ -220,7 +220,19 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
     }
   }
   if (report.status == "ok") interrupted();  // a signal during the last frame
-  if (!odo.failed() && report.status == "ok") odo.finish();
+  if (!odo.failed() && report.status == "ok") {
+    odo.finish();
+  } else if (odo.failed() && report.status == "ok") {
+    // A run the odometry gave up on still logs its window (diagnostics rows of the observations in it,
+    // the keyframes' last states, the points): `rsvio diagnose` works from what was there when it
+    // failed, also when it failed before anything was marginalised. finish() skips the optimisation of
+    // a failed estimator.
+    try {
+      odo.finish();
+    } catch (const std::exception& e) {
+      report.warnings.push_back(std::string("the failed run's window could not be written out: ") + e.what());
+    }
+  }
   const double wall = secondsSince(t_start);
   if (odo.failed() && report.status != "interrupted") {
     report.status = "failed";
