@@ -1,18 +1,23 @@
-// rsvio demo [--out DIR]: the main job on a built-in synthetic sequence.
-//   1. simulate configs/sim/demo.json afresh (a rolling shutter hidden from the calibration),
-//   2. run the global-shutter model configs/gs_vo.json on it, evaluated against the ground truth,
-//   3. render the run's figures and index.html,
-//   4. print what it assembled, the figures and the paths of the outputs.
-// Exit 0 once the run has written its report, even when the model failed on the sequence (that is
-// what the demo shows); non-zero when a step could not be done (simulation, config, output folder).
-// The diagnosis loop (diagnose, switch the named plugin on, run again, compare) joins when
-// `rsvio diagnose` lands; until then the demo says so instead of pretending.
+// rsvio demo [--out DIR] [--fresh]: the main job on a built-in synthetic sequence.
+//   1. simulate configs/sim/demo.json (a rolling shutter hidden from the calibration) into <out>/data,
+//      or reuse <out>/data when it was simulated before from the same effective config and seed
+//      (written to <out>/data.partial and renamed when complete, so a half-written dataset is never reused),
+//   2. run the default model configs/gs_vo.json on it (evaluated against the ground truth) and render,
+//   3. diagnose the run from its folder alone (rsvio diagnose): verdict, ranking, the line to add,
+//   4. run again with the named line (when there is one) and render,
+//   5. compare (rsvio diagnose --against): ATE before and after, is the evidence gone,
+// then a few lines: verdict, line added, ATE before and after, figure paths.
+// Exit 0 once the story is told, also when a model fails on the sequence (that is what the demo shows);
+// non-zero when a step could not be done (simulation, config, output folder).
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <filesystem>
 #include <iostream>
 
 #include "commands.h"
+#include "diagnose.h"
 #include "render_hook.h"
 #include "run_summary.h"
 #include "rsvio/core/error.h"
@@ -44,7 +49,76 @@ void printAssembled(const nlohmann::json& cfg) {
   }
 }
 
-int runDemo(const std::string& out, const GlobalOptions& g) {
+// The dataset of the demo: reused when <out>/data was simulated before from the same effective config
+// (seed included), else simulated into <out>/data.partial and renamed into place once complete, so an
+// interrupted simulation never leaves a dataset that looks whole.
+bool prepareData(const std::string& sim_cfg, const std::string& data, bool fresh, PluginHost& host) {
+  const nlohmann::json eff = sim::loadSimConfig(sim_cfg, {}, std::nullopt, host);
+  const fs::path stamp = fs::path(data) / "rsvio_demo_sim_config.json";
+  if (!fresh && fs::exists(stamp) && fs::exists(fs::path(data) / "mav0")) {
+    std::ifstream in(stamp);
+    nlohmann::json before;
+    try {
+      before = nlohmann::json::parse(in);
+    } catch (const std::exception&) {
+    }
+    if (before == eff) return true;
+  }
+  const fs::path partial = data + ".partial";
+  fs::remove_all(partial);
+  {
+    sim::Simulator simulator(eff, host);
+    simulator.write(partial.string());
+  }
+  {
+    std::ofstream out(partial / "rsvio_demo_sim_config.json");
+    out << eff.dump(2) << "\n";
+    if (!out) throw Error((partial / "rsvio_demo_sim_config.json").string() + ": cannot write");
+  }
+  fs::remove_all(data);
+  fs::rename(partial, data);
+  return false;
+}
+
+// "--set a=b --set c=d" -> {"a=b", "c=d"}.
+std::vector<std::string> setsOf(const std::string& line) {
+  std::istringstream is(line);
+  std::vector<std::string> out;
+  std::string tok;
+  bool next_is_value = false;
+  while (is >> tok) {
+    if (tok == "--set") {
+      next_is_value = true;
+      continue;
+    }
+    if (next_is_value) out.push_back(tok);
+    next_is_value = false;
+  }
+  return out;
+}
+
+RunResult runOnce(const std::string& cfg, const std::vector<std::string>& sets, const std::string& data,
+                  const std::string& dir, const GlobalOptions& g, PluginHost& host) {
+  RunRequest req;
+  req.config_path = cfg;
+  req.sets = sets;
+  req.data_dir = data;
+  req.out_dir = dir;
+  req.verbosity = g.verbosity;
+  RunResult res = runPipeline(req, host);
+  printRunWarnings(res.report, "demo");
+  renderRunOutputs(dir, g.verbosity);
+  return res;
+}
+
+std::string ateText(const Report& rep) {
+  char b[128];
+  if (rep.eval) std::snprintf(b, sizeof b, "%.4f m", rep.eval->ate_rmse_m);
+  else std::snprintf(b, sizeof b, "n/a");
+  return rep.ok() ? std::string(b) : std::string(b) + " (run failed: " + rep.error + ")";
+}
+
+int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
   const std::string cfg_dir = configDir();
   const std::string sim_cfg = (fs::path(cfg_dir) / "sim" / "demo.json").string();
   const std::string run_cfg = (fs::path(cfg_dir) / "gs_vo.json").string();
@@ -52,52 +126,78 @@ int runDemo(const std::string& out, const GlobalOptions& g) {
     if (!fs::exists(p)) throw Error(p + ": demo config not found (set RSVIO_CONFIG_DIR to rsvio's configs/ folder)");
   PluginHost host(PluginHost::defaultSearchPath(g.plugin_path));
   const std::string data = (fs::path(out) / "data").string();
-  const std::string run_dir = (fs::path(out) / "gs_vo").string();
+  const std::string before_dir = (fs::path(out) / "gs_vo").string();
+  const std::string after_dir = (fs::path(out) / "gs_vo_fixed").string();
 
-  std::printf("rsvio demo: 1/3 simulating %s into %s\n", sim_cfg.c_str(), data.c_str());
+  std::printf("rsvio demo: 1/5 simulating %s into %s\n", sim_cfg.c_str(), data.c_str());
   std::fflush(stdout);
-  fs::remove_all(data);
   const auto t0 = std::chrono::steady_clock::now();
-  {
-    sim::Simulator simulator(sim::loadSimConfig(sim_cfg, {}, std::nullopt, host), host);
-    simulator.write(data);
-  }
-  std::printf("  simulated in %.1f s\n",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (prepareData(sim_cfg, data, fresh, host))
+    std::printf("  reusing the dataset simulated before from the same config and seed (--fresh simulates again)\n");
+  else
+    std::printf("  simulated in %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 
-  std::printf("rsvio demo: 2/3 running %s\n", run_cfg.c_str());
-  RunRequest req;
-  req.config_path = run_cfg;
-  req.data_dir = data;
-  req.out_dir = run_dir;
-  req.verbosity = g.verbosity;
+  std::printf("rsvio demo: 2/5 running the default model %s\n", run_cfg.c_str());
   printAssembled(loadRunConfig(run_cfg, {}, host));
   std::fflush(stdout);
-  RunResult res = runPipeline(req, host);
-
-  printRunWarnings(res.report, "demo");
-  std::printf("rsvio demo: 3/3 rendering\n");
-  std::fflush(stdout);
-  renderRunOutputs(run_dir, g.verbosity);
-
-  const Report& rep = res.report;
-  std::printf("\nresult: %s, %ld frames, %ld keyframes, %.1f fps (realtime factor %.2f)\n", rep.status.c_str(),
-              rep.frames, rep.keyframes, rep.fps, rep.realtime_factor);
-  if (!rep.ok()) {
-    std::printf("  failure: %s\n", rep.error.c_str());
-    std::printf("  (expected on this sequence: its camera has a ~30 ms rolling-shutter readout that the global-shutter\n"
-                "   model does not know; on its global-shutter twin, --set effects.rolling_shutter=null, gs_vo tracks)\n");
-  }
-  if (rep.eval) std::printf("  ATE (keyframes, %s): %.4f m\n", rep.eval->align.c_str(), rep.eval->ate_rmse_m);
-  const std::string not_used = notUsedLine(rep, data, res.effective_config["output"]["evaluate"].get<bool>());
+  RunResult before = runOnce(run_cfg, {}, data, before_dir, g, host);
+  const Report& rb = before.report;
+  std::printf("  %s, %ld frames, %ld keyframes, %.1f fps (realtime factor %.2f), ATE %s\n", rb.status.c_str(), rb.frames,
+              rb.keyframes, rb.fps, rb.realtime_factor, ateText(rb).c_str());
+  const std::string not_used = notUsedLine(rb, data, before.effective_config["output"]["evaluate"].get<bool>());
   if (!not_used.empty()) std::printf("  %s\n", not_used.c_str());
-  if (!rep.stage_ms.empty()) std::printf("  stage times (mean per call, ms):\n");
-  for (const auto& [stage, ms] : rep.stage_ms) std::printf("    %-20s %8.2f\n", stage.c_str(), ms);
-  std::printf("outputs: %s (trajectory.tum, keyframes.tum, points.ply, states.csv, report.json)\n", run_dir.c_str());
-  std::printf("figures: %s\n", (fs::path(run_dir) / "index.html").string().c_str());
-  std::printf("next: the diagnosis loop (rsvio diagnose --run %s) is not available yet\n", run_dir.c_str());
-  // The demo's job is done when the run produced its report, whatever the model made of the sequence:
-  // a global-shutter model failing on a hidden rolling shutter is the demo's finding, not its error.
+
+  std::printf("rsvio demo: 3/5 diagnosing %s (from its folder alone)\n", before_dir.c_str());
+  std::fflush(stdout);
+  DiagnoseRequest dq;
+  dq.run_dir = before_dir;
+  const nlohmann::json d = diagnoseRun(dq, host);
+  std::istringstream dtext(formatDiagnosis(d));
+  for (std::string l; std::getline(dtext, l);)
+    if (l.rfind("figures:", 0) != 0) std::printf("  %s\n", l.c_str());
+  const std::string verdict = d["verdict"];
+  std::string line;
+  nlohmann::json cmp;
+  RunResult after;
+  bool ran_after = false;
+  if (verdict != "none") {
+    line = d["config_line"];
+    std::printf("rsvio demo: 4/5 running again with the named line: %s\n", line.c_str());
+    std::fflush(stdout);
+    after = runOnce(run_cfg, setsOf(line), data, after_dir, g, host);
+    ran_after = true;
+    std::printf("rsvio demo: 5/5 comparing (rsvio diagnose --run %s --against %s)\n", after_dir.c_str(),
+                before_dir.c_str());
+    std::fflush(stdout);
+    DiagnoseRequest aq;
+    aq.run_dir = after_dir;
+    aq.against = before_dir;
+    cmp = diagnoseRun(aq, host);
+  } else {
+    std::printf("rsvio demo: 4/5 and 5/5 skipped: the diagnosis names no missing effect\n");
+  }
+
+  std::printf("\nsequence: %s (hidden: a ~30 ms rolling-shutter readout the calibration does not know)\n", data.c_str());
+  std::printf("verdict:  %s\n", verdict.c_str());
+  if (!line.empty()) std::printf("added:    %s\n", line.c_str());
+  std::printf("ATE before (default model): %s\n", ateText(rb).c_str());
+  if (ran_after) {
+    std::printf("ATE after  (with the line): %s\n", ateText(after.report).c_str());
+    if (cmp.contains("against") && cmp["against"].contains("evidence_gone"))
+      std::printf("evidence of %s after the change: %s\n", verdict.c_str(),
+                  cmp["against"]["evidence_gone"].get<bool>() ? "gone" : "still there");
+  }
+  std::printf("figures:  %s\n", (fs::path(before_dir) / "index.html").string().c_str());
+  for (const auto& f : d["figures"])
+    if (f.get<std::string>().find("diagnose_" + verdict) != std::string::npos) std::printf("          %s\n", f.get<std::string>().c_str());
+  if (ran_after) {
+    std::printf("          %s\n", (fs::path(after_dir) / "index.html").string().c_str());
+    for (const auto& f : cmp["figures"])
+      if (f.get<std::string>().find("against/diagnose_" + verdict) != std::string::npos)
+        std::printf("          %s\n", f.get<std::string>().c_str());
+  }
+  // The demo's job is done when it has told the story, whatever the models made of the sequence: a
+  // global-shutter model failing on a hidden rolling shutter is the demo's finding, not its error.
   return 0;
 }
 
@@ -106,8 +206,10 @@ int runDemo(const std::string& out, const GlobalOptions& g) {
 void addDemoCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
   auto* sub = root.add_subcommand("demo", "the main job on a built-in synthetic sequence");
   static std::string out = "out/demo";
+  static bool fresh = false;
   sub->add_option("--out", out, "output folder")->capture_default_str();
-  sub->callback([&g, &r] { r.exit_code = runDemo(out, g); });
+  sub->add_flag("--fresh", fresh, "simulate the sequence again even when <out>/data holds it already");
+  sub->callback([&g, &r] { r.exit_code = runDemo(out, fresh, g); });
 }
 
 }  // namespace rsvio::app
