@@ -10,7 +10,8 @@
 #
 # Effects: rolling_shutter (rs.json, 58.94 us per row = 30 ms readout), exposure (exposure.json, +-1 stop
 # over 8 s, 0.05 stops jitter), vignetting (vignette.json, corner at half), response (response.json,
-# gamma 2.2). time_offset needs the visual-inertial estimator and is not run yet.
+# gamma 2.2). "ratio" is ATE before / after; it compares unequal spans when the before run failed.
+# time_offset needs the visual-inertial estimator and is not run yet.
 # The "before" model is configs/gs_vo.json; for exposure without affine brightness
 # (--set photometric.affine=null), since gs_vo already models it.
 set -euo pipefail
@@ -41,6 +42,11 @@ field() {  # field JSON_FILE PYTHON_EXPR
   python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print($2)" "$1"
 }
 
+# ATE in m; a failed run shows "F<frames>" (lost after that many frames; its ATE covers only those).
+ate_of() {
+  field "$1" "('%.4f' % d['eval']['ate_rmse_m'] if 'eval' in d else 'n/a') + ('' if d['status'] == 'ok' else ' F%d' % d['frames'])"
+}
+
 printf "%-16s %4s %-16s %-44s %12s %12s %8s %s\n" effect seed verdict "top: statistic / threshold (score)" \
   "ATE before" "ATE after" ratio "evidence" | tee "$TABLE"
 
@@ -60,15 +66,13 @@ one() {
   local verdict line top ate_b ate_a="-" ratio="-" ev="-"
   verdict=$(field "$d/diagnose.json" "d['verdict']")
   top=$(field "$d/diagnose.json" "(lambda e: '%s %.3g / %.3g (%.2f)' % (e['effect'], e['statistic'], e['threshold'], e['score']))(d['ranking'][0]) if d['ranking'] else '-'")
-  ate_b=$(field "$d/before/report.json" "'%.4f' % d['eval']['ate_rmse_m'] if 'eval' in d else 'n/a'")
-  [ "$(field "$d/before/report.json" "d['status']")" = ok ] || ate_b="$ate_b(F)"
+  ate_b=$(ate_of "$d/before/report.json")
   if [ "$verdict" != none ]; then
     line=$(field "$d/diagnose.json" "d['config_line']")
     # shellcheck disable=SC2046,SC2086
     "$BIN" run --config "$CFG/gs_vo.json" --data "$data" --out "$d/after" $(base_sets "$effect") $line > "$d/after.log" 2>&1 || true
     "$BIN" diagnose --run "$d/after" --against "$d/before" --json > "$d/against.json" 2>/dev/null || true
-    ate_a=$(field "$d/after/report.json" "'%.4f' % d['eval']['ate_rmse_m'] if 'eval' in d else 'n/a'")
-    [ "$(field "$d/after/report.json" "d['status']")" = ok ] || ate_a="$ate_a(F)"
+    ate_a=$(ate_of "$d/after/report.json")
     ratio=$(field "$d/against.json" "'%.2f' % d['against']['ate_ratio'] if 'ate_ratio' in d['against'] else '-'")
     ev=$(field "$d/against.json" "('gone' if d['against']['evidence_gone'] else 'still there') if 'evidence_gone' in d['against'] else '-'")
   fi
