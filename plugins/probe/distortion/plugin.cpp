@@ -57,7 +57,7 @@ class DistortionProbe : public DiagnosticProbe {
 };
 
 ParamTable table() {
-  return {paramDouble("threshold", 6.0, 0.0, 1e6, "",
+  return {paramDouble("threshold", 10.0, 0.0, 1e6, "",
                       "|z| of the radial-shift score test above which the effect is named (README: false-alarm rate)")};
 }
 
