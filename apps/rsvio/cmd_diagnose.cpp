@@ -289,6 +289,11 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
     }
   }
   d["verdict"] = effectOf(ranking);
+  // "none" means "nothing stands out" only when the probes had data to look at.
+  bool any_data = false;
+  for (const auto& e : ranking)
+    if (e["explanation"].get<std::string>().rfind("too little data", 0) != 0) any_data = true;
+  d["enough_data"] = any_data;
   d["ranking"] = ranking;
   d["not_applicable"] = na;
   if (d["verdict"] != "none") {
@@ -394,7 +399,10 @@ std::string formatDiagnosis(const nlohmann::json& d) {
   }
   for (const auto& e : d["not_applicable"])
     o << "  " << e["effect"].get<std::string>() << ": not tested, " << e["why"].get<std::string>() << "\n";
-  if (d["verdict"] == "none") {
+  if (d["verdict"] == "none" && !d.value("enough_data", true)) {
+    o << "verdict: none -- too little data to diagnose (no probe found enough frame pairs; a run that fails\n"
+         "  during its start logs almost nothing)\n";
+  } else if (d["verdict"] == "none") {
     o << "verdict: none (no probe's statistic above its threshold)\n";
   } else {
     o << "verdict: " << d["verdict"].get<std::string>() << " -- " << d["ranking"][0]["explanation"].get<std::string>()
