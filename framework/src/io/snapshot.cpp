@@ -155,10 +155,13 @@ Snapshot readSnapshot(const std::string& run_dir, const SnapshotOptions& options
   readOptional(dir / "states.csv", notes, [&](const std::string& p) { s.states = readStates(p); });
   if (fs::exists(dir / "diagnostics.bin")) s.diagnostics_path = (dir / "diagnostics.bin").string();
 
-  // Ground truth: an explicit file, else the dataset folder the report names (as written, then
-  // relative to the run folder).
+  // Ground truth: an explicit file, else the dataset folder the report names. A relative "dataset" in
+  // report.json is relative to the run folder first (a folder of that name beside the current
+  // directory must not win); a relative --data of the caller is relative to the current directory.
   std::string dataset = options.dataset_dir.empty() ? s.summary.dataset : options.dataset_dir;
-  if (!dataset.empty() && !fs::is_directory(dataset) && fs::is_directory(dir / dataset)) {
+  const bool from_report = options.dataset_dir.empty();
+  if (!dataset.empty() && fs::path(dataset).is_relative() && fs::is_directory(dir / dataset) &&
+      (from_report || !fs::is_directory(dataset))) {
     dataset = (dir / dataset).string();
   }
   const bool have_dataset = !dataset.empty() && fs::is_directory(dataset);
