@@ -31,7 +31,7 @@ void addRunCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
     printRunWarnings(rep);  // every warning report.json records, once, on stderr
     if (rep.status == "interrupted") {
       std::cerr << "rsvio run: " << rep.error << " (outputs so far in " << res.out_dir << ")\n";
-      r.exit_code = 130;
+      r.exit_code = kExitInterrupted;
       return;
     }
     if (res.effective_config["output"]["render"].get<bool>()) renderRunOutputs(res.out_dir, g.verbosity);
@@ -43,10 +43,13 @@ void addRunCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
       const std::string not_used = notUsedLine(rep, req.data_dir, res.effective_config["output"]["evaluate"].get<bool>());
       if (!not_used.empty()) std::printf("%s\n", not_used.c_str());
       std::printf("outputs in %s\n", res.out_dir.c_str());
-      r.exit_code = 0;
+      r.exit_code = kExitOk;
     } else {
+      const std::string not_used = notUsedLine(rep, req.data_dir, res.effective_config["output"]["evaluate"].get<bool>());
+      if (!not_used.empty()) std::printf("%s\n", not_used.c_str());  // stdout: stderr keeps its one line
+      std::fflush(stdout);
       std::cerr << "rsvio run: failed: " << rep.error << " (outputs so far in " << res.out_dir << ")\n";
-      r.exit_code = 1;
+      r.exit_code = kExitFailed;
     }
   });
 }
