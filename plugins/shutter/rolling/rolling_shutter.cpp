@@ -18,6 +18,8 @@ namespace {
 
 const char* kName = "shutter.rolling";
 
+ParamTable rollingParams();  // the parameter table, below
+
 class RollingShutter : public ShutterModel {
  public:
   explicit RollingShutter(const Params& p)
@@ -26,8 +28,12 @@ class RollingShutter : public ShutterModel {
   void setCalibration(const CameraCalibration& calib) override {
     double ld = param_line_delay_us_ > 0.0 ? param_line_delay_us_ * 1e-6 : calib.line_delay_s;
     if (!(ld > 0.0) || !std::isfinite(ld)) {
-      throw ConfigError(std::string(kName) + " needs line_delay_us: the calibration has no line delay; give it with "
-                        "--set shutter.params.line_delay_us=<microseconds per row> (readout time / image rows)");
+      std::string msg = std::string(kName) + " needs line_delay_us: the calibration has no line delay; give it with "
+                        "--set shutter.params.line_delay_us=<microseconds per row> (readout time / image rows)";
+      // When the plugin can estimate it, say so too (tests/apps/cli/newcomer_test.cpp holds this).
+      for (const auto& spec : rollingParams())
+        if (spec.key == "estimate_line_delay") msg += ", or estimate it with --set shutter.params.estimate_line_delay=true";
+      throw ConfigError(msg);
     }
     const std::string readout = param_readout_ == "calibration" ? calib.readout : param_readout_;
     if (readout == "top_down") {

@@ -196,8 +196,12 @@ TEST_F(Newcomer, RollingShutterWithoutLineDelaySaysHowToGiveIt) {
                          (scratch() / "rs").string() + " --set output.render=false");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--set shutter.params.line_delay_us="), std::string::npos) << r.err;
-  const bool can_estimate = slurp(kSrc + "/plugins/shutter/rolling/rolling_shutter.cpp").find("estimate_line_delay") !=
-                            std::string::npos;
+  // Whether shutter.rolling offers estimate_line_delay: its parameter table, as rsvio plugins lists it.
+  bool can_estimate = false;
+  const Result pl = rsvio("plugins --json");
+  for (const auto& p : nlohmann::json::parse(pl.out)["plugins"])
+    if (p["name"] == "shutter.rolling")
+      for (const auto& q : p["params"]) can_estimate |= q["key"] == "estimate_line_delay";
   EXPECT_EQ(r.err.find("shutter.params.estimate_line_delay=true") != std::string::npos, can_estimate) << r.err;
 }
 
