@@ -16,6 +16,7 @@
 #include "rsvio/config/config.h"
 #include "rsvio/core/error.h"
 #include "rsvio/eval/compare.h"
+#include "rsvio/pipeline/run.h"
 #ifdef RSVIO_HAVE_VIZ
 #include "rsvio/viz/render_run.h"
 #endif
@@ -29,14 +30,7 @@ extern "C" void onCompareSignal(int) {
   if (g_compare_signals < 2) g_compare_signals = g_compare_signals + 1;
 }
 
-void installCompareSignalHandlers() {
-  struct sigaction sa {};
-  sa.sa_handler = onCompareSignal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESTART;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
+void installCompareSignalHandlers() { installInterruptHandler(onCompareSignal); }
 
 struct CompareArgs {
   std::vector<std::string> configs, datasets, sets;

@@ -117,14 +117,16 @@ void evaluate(const std::string& data_dir, const std::string& out, Report& repor
 
 }  // namespace
 
-void installRunInterruptHandlers() {
+void installInterruptHandler(void (*handler)(int)) {
   struct sigaction sa {};
-  sa.sa_handler = onRunInterrupt;
+  sa.sa_handler = handler;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESTART;
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 }
+
+void installRunInterruptHandlers() { installInterruptHandler(onRunInterrupt); }
 
 int runInterruptSignal() { return g_interrupt_signal; }
 

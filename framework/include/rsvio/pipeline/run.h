@@ -58,6 +58,8 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host);
 
 // SIGINT/SIGTERM handlers for the process (see "Interrupts" above); `rsvio run` installs them.
 void installRunInterruptHandlers();
+// Installs `handler` for SIGINT and SIGTERM (SA_RESTART); the run's handlers and rsvio compare's use it.
+void installInterruptHandler(void (*handler)(int));
 // The signal that asked the run to stop (0: none yet).
 int runInterruptSignal();
 // Asks a run in progress (or the next one) to stop as a signal would; sig = 0 clears the request.
