@@ -86,11 +86,13 @@ struct BundleAdjuster::Impl {
   std::vector<int> point_obs_begin;     // per point, into obs_refs (its obs are contiguous)
   std::vector<PairWork> pairs;
   std::vector<uint8_t> fixed;           // per camera dimension
-  int nc = 0;                           // camera dimensions
+  int nc = 0;                           // camera dimensions: all keyframe and global states
+  int nkd = 0;                          // photometric dimensions (the leading nkd of nc), coupled to points
   // Linearisations: current (accepted) and trial.
   Linearization cur, trial;
   std::vector<ChunkSums> chunks;
   const MarginalizationPrior* prior = nullptr;
+  GlobalStates* globals = nullptr;      // visual-inertial: updated with the keyframes
 };
 
 }  // namespace rsvio

@@ -15,7 +15,8 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
   m.window = &window;
   const int nk = static_cast<int>(window.size());
   const int kd = cfg.layout.kfDim();
-  m.nc = nk * kd;
+  m.nkd = nk * kd;
+  m.nc = cfg.layout.windowDim(nk);
   if (only) {
     std::vector<ActivePoint*> copy = *only;  // `only` may be m.points itself (BundleAdjuster::points())
     m.points.swap(copy);
@@ -50,6 +51,8 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
       for (int i = 0; i < 8; ++i) f[i] = 1;
     if (!cfg.estimate_affine) f[StateLayout::kAffine] = f[StateLayout::kAffine + 1] = 1;
   }
+  // The yaw of T_Wm_Wf about gravity is unobservable (visual_inertial_factor.h): held.
+  if (cfg.layout.inertial) m.fixed[static_cast<size_t>(cfg.layout.globalOffset(nk) + StateLayout::kGlobalRot + 2)] = 1;
   // Arena of per-point blocks: host + one per observation at most.
   for (Linearization* L : {&m.cur, &m.trial}) {
     L->obs.resize(m.obs_refs.size());
@@ -66,9 +69,9 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
     L->hpc.resize(static_cast<size_t>(total) * kd);
   }
   m.chunks.resize(kPointChunks);
-  for (ChunkSums& c : m.chunks) {
-    c.H.resize(m.nc, m.nc);
-    c.b.resize(m.nc);
+  for (ChunkSums& c : m.chunks) {  // points couple to the photometric blocks only
+    c.H.resize(m.nkd, m.nkd);
+    c.b.resize(m.nkd);
   }
 }
 
@@ -289,8 +292,8 @@ void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundl
   L.energy_photo = L.energy_photo_in = 0.0;
   L.num_in = L.num_oob = L.num_outlier = 0;
   for (const ChunkSums& c : m.chunks) {  // fixed order: deterministic
-    L.Hcc += c.H;
-    L.bc += c.b;
+    L.Hcc.topLeftCorner(m.nkd, m.nkd) += c.H;
+    L.bc.head(m.nkd) += c.b;
     L.energy_photo += c.energy;
     L.energy_photo_in += c.energy_in;
     L.num_in += c.num_in;

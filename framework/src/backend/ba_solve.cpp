@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "ba_internal.h"
+#include "rsvio/core/error.h"
 #include "rsvio/interfaces/solver.h"
 
 namespace rsvio {
@@ -110,8 +111,8 @@ bool solveSchur(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdj
     m.runner->run(kPointChunks, [&](int c) { schurChunk<8>(m, L, lambda, keep, c); });
   }
   for (const ChunkSums& c : m.chunks) {
-    H -= c.H;
-    b -= c.b;
+    H.topLeftCorner(m.nkd, m.nkd) -= c.H;
+    b.head(m.nkd) -= c.b;
   }
   SolverStats st;
   if (!solver.solveDense(H, b, dx_c, &st)) {
@@ -194,6 +195,8 @@ void removeScaleDirection(const BundleAdjuster::Impl& m, const Linearization& L,
     n.segment<3>(kf->index * kd + StateLayout::kPose) = kf->state.T_c_w.translation();
     if (cfg.layout.rolling) n.segment<3>(kf->index * kd + StateLayout::kTwist) = kf->state.twist.head<3>();
   }
+  // With the inertial state the null direction scales T_Wm_Wf inversely: sigma = log s moves by -1.
+  if (cfg.layout.inertial) n[cfg.layout.globalOffset(static_cast<int>(m.window->size())) + StateLayout::kGlobalScale] = -1.0;
   for (int i = 0; i < m.nc; ++i) n[i] *= keep[static_cast<size_t>(i)];
   // Oblique projection: the scale is measured on the translations only (m), the removed component is
   // along the null direction n. With a rolling shutter the twist velocities are weakly observable;
@@ -202,6 +205,7 @@ void removeScaleDirection(const BundleAdjuster::Impl& m, const Linearization& L,
   Eigen::VectorXd mv = n;
   if (cfg.layout.rolling)
     for (const auto& kf : *m.window) mv.segment<3>(kf->index * kd + StateLayout::kTwist).setZero();
+  if (cfg.layout.inertial) mv.tail(m.nc - m.nkd).setZero();
   const double mn = mv.dot(n);
   if (!(mn > 0.0)) return;
   dx_c -= n * (mv.dot(dx_c) / mn);
@@ -244,6 +248,14 @@ BundleAdjuster::BundleAdjuster(const BundleAdjustmentConfig& config, const Camer
 }
 
 BundleAdjuster::~BundleAdjuster() = default;
+
+void BundleAdjuster::setConfig(const BundleAdjustmentConfig& config) {
+  if (config.layout.rolling != config_.layout.rolling)
+    throw Error("BundleAdjuster::setConfig: the shutter (rolling or global) cannot change");
+  config_ = config;
+}
+
+void BundleAdjuster::setGlobals(GlobalStates* globals) { impl_->globals = globals; }
 
 const std::vector<ActivePoint*>& BundleAdjuster::points() const { return impl_->points; }
 
@@ -309,9 +321,18 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       continue;
     }
     if (config_.fix_scale_gauge) ba::removeScaleDirection(m, m.cur, config_, lambda, dx_c, dx_p);
+    const int nk = static_cast<int>(window.size());
     for (auto& kf : window) {
       kf->backup = kf->state;
-      applyStep(kf->state, dx_c.segment(kf->index * kd, kd), config_.layout);
+      if (config_.layout.inertial)
+        applyStep(kf->state, gatherState(dx_c, kf->index, nk, config_.layout), config_.layout);
+      else
+        applyStep(kf->state, dx_c.segment(kf->index * kd, kd), config_.layout);
+    }
+    if (m.globals && config_.layout.inertial) {
+      m.globals->backup = m.globals->state;
+      applyGlobalStep(m.globals->state, dx_c.segment(config_.layout.globalOffset(nk), config_.layout.globalDim()),
+                      config_.layout);
     }
     for (size_t i = 0; i < m.points.size(); ++i) {
       ActivePoint& p = *m.points[i];
@@ -331,6 +352,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       if (rel < config_.step_threshold) break;
     } else {
       for (auto& kf : window) kf->state = kf->backup;
+      if (m.globals && config_.layout.inertial) m.globals->state = m.globals->backup;
       for (size_t i = 0; i < m.points.size(); ++i) m.points[i]->idepth = idepth_backup[i];
       lambda *= 4.0;
     }
@@ -404,8 +426,8 @@ void BundleAdjuster::pointsTerm(const KeyframeList& window, const std::vector<Ac
   Hf = m.cur.Hcc;
   bf = m.cur.bc;
   for (const ba::ChunkSums& c : m.chunks) {
-    Hf -= c.H;
-    bf -= c.b;
+    Hf.topLeftCorner(m.nkd, m.nkd) -= c.H;
+    bf.head(m.nkd) -= c.b;
   }
   for (int i = 0; i < m.nc; ++i) {
     if (keep[static_cast<size_t>(i)] != 0.0) continue;

@@ -3,6 +3,7 @@
 #include "rsvio/backend/backend_options.h"
 #include "rsvio/config/validate.h"
 #include "rsvio/frontend/frontend_options.h"
+#include "rsvio/imu/inertial_options.h"
 
 namespace rsvio {
 
@@ -22,6 +23,8 @@ ConfigSchema runConfigSchema() {
   s.section("frontend", frontendParamTable(), "photometric front end: pyramid, point selection, tracking");
   s.section("backend", backendParamTable(),
             "photometric back end: window, keyframes, marginalisation, monocular start, divergence tests");
+  s.section("imu", inertialParamTable(),
+            "visual-inertial estimation: IMU factors, scale and gravity, twist energy, time offset (off: VO)");
   s.section("output",
             {paramBool("render", true, "render figures and index.html at the end of the run"),
              paramBool("diagnostics", true, "write diagnostics.bin for rsvio diagnose"),

@@ -112,6 +112,13 @@ class ImuMotionPrior : public MotionPrior {
     return true;
   }
 
+  // The same Sigma for the twist energy inside the window optimisation (visual-inertial runs).
+  bool twistEnergySigma(double* sigma_trans_m_s, double* sigma_rot_rad_s) const override {
+    *sigma_trans_m_s = o_.twist_sigma_trans_m_s;
+    *sigma_rot_rad_s = o_.twist_sigma_rot_rad_s;
+    return true;
+  }
+
   const ImuMotionOptions& options() const { return o_; }
 
  private:

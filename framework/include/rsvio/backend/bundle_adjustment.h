@@ -25,7 +25,11 @@
 // - Fixed dimensions (the gauge keyframe's pose and a, b; a, b of every keyframe when affine
 //   brightness is not estimated) get zero rows and a unit diagonal: their step is 0.
 // - Gauge: pose and a, b of a keyframe with Keyframe::gauge are fixed; the monocular scale is a null
-//   direction that every step is projected off (fix_scale_gauge), so the steps never change it.
+//   direction that every step is projected off (fix_scale_gauge), so the steps never change it. With
+//   the inertial state the W_f scale stays a null direction together with the scale of T_Wm_Wf
+//   (scaling W_f by 1 + e and s by 1 / (1 + e) changes no residual): the projection then includes
+//   sigma = log s, so the steps change the metric scale through s only; the yaw of T_Wm_Wf (omega_z,
+//   unobservable: visual_inertial_factor.h) is a fixed dimension.
 // - Determinism and threads: residuals are evaluated per host-target pair and accumulated per block
 //   of points into their own partial sums, added in block order: the result is identical for 1 and 2
 //   threads. No allocation per residual; buffers are reused across iterations.
@@ -47,11 +51,12 @@ class CameraModel;
 class SolverBackend;
 class BlockRunner;
 
-// A term over keyframe states only (no points): priors now, IMU factors later.
+// A term over keyframe and global states only (no points): priors, IMU factors, the twist energy.
 class WindowTerm {
  public:
   virtual ~WindowTerm() = default;
-  // Adds J^T W J and -J^T W r at the current states into H, b (window block order); returns the energy.
+  // Adds J^T W J and -J^T W r at the current states into H, b (the window system of window.h:
+  // StateLayout's photometric, inertial and global offsets); returns the energy.
   virtual double linearize(const KeyframeList& window, const StateLayout& layout, Eigen::MatrixXd& H,
                            Eigen::VectorXd& b) const = 0;
 };
@@ -96,6 +101,10 @@ class BundleAdjuster {
 
   const BundleAdjustmentConfig& config() const { return config_; }
   void setTerms(std::vector<const WindowTerm*> terms) { terms_ = std::move(terms); }
+  // Visual-inertial: the layout gains the inertial and global blocks at the initialisation (the shutter
+  // cannot change), and the global states the steps update (backup and restore as the keyframes').
+  void setConfig(const BundleAdjustmentConfig& config);
+  void setGlobals(GlobalStates* globals);
 
   // Levenberg-Marquardt on the window (see the contract). Observation states and the points'
   // idepth_hessian are updated from the final linearisation.

@@ -17,7 +17,11 @@
 //   affine parameters that are not estimated) must be zero in added terms (the back end zeroes them):
 //   their zero rows then drop out of the pseudo-inverse, which conditions on them as known values.
 // - Keyframes are identified by Keyframe*; blocks are ordered by entry. All keyframes in the prior are
-//   in the window.
+//   in the window. A block is the keyframe's full state (StateLayout::stateDim(): photometric, then
+//   inertial when visual-inertial); a visual-inertial prior ends with the global block (T_Wm_Wf, time
+//   offset: StateLayout::globalDim()) of the GlobalStates given by setGlobals(), whose linearisation
+//   point is frozen the first time a term reaches it. addTo() scatters the blocks to the window
+//   system's photometric, inertial and global offsets (window.h).
 #pragma once
 #include <Eigen/Core>
 #include <vector>
@@ -40,9 +44,17 @@ class MarginalizationPrior {
   // Gives kf a block (zero information) and freezes its linearisation point at its current state.
   void addKeyframe(Keyframe* kf);
 
-  // Adds a term linearised at the current states. H_t, b_t are over `kfs` (each kfDim() rows, in that
-  // order); keyframes without a block get one first.
-  void addTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t, const Eigen::VectorXd& b_t);
+  // Visual-inertial: the global states of the window (their delta enters the prior's).
+  void setGlobals(GlobalStates* g);
+  // The inertial state joins (visual-inertial initialisation): every block grows by an empty inertial
+  // block and an empty global block is appended. The shutter cannot change.
+  void setLayout(const StateLayout& layout);
+
+  // Adds a term linearised at the current states. H_t, b_t are over `kfs` (each kfDim() rows, or each
+  // stateDim() rows, in that order), followed by the global block (globalDim() rows) when with_global;
+  // keyframes without a block get one first.
+  void addTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t, const Eigen::VectorXd& b_t,
+               bool with_global = false);
 
   // The same for a term whose keyframes are the window's only through points that scaled with them
   // (marginalised points): when project_scale is set, the monocular scale direction at the keyframes'
@@ -61,11 +73,13 @@ class MarginalizationPrior {
   double addTo(Eigen::MatrixXd& H_win, Eigen::VectorXd& b_win) const;
   double energy() const;  // E_m(delta) at the current states
 
-  // Stacked delta of every block at the current states.
+  // Stacked delta of every block at the current states (the global block last).
   Eigen::VectorXd delta() const;
 
  private:
+  void ensureGlobalBlock();
   StateLayout layout_;
+  GlobalStates* globals_ = nullptr;
   std::vector<Keyframe*> keyframes_;
   Eigen::MatrixXd H_;
   Eigen::VectorXd b_;

@@ -6,9 +6,15 @@
 //   raw row y0), affine brightness (a, b) and, when the shutter is rolling, the twist xi per second
 //   (translation; rotation), T_c_w(t) = exp(xi t) T_c_w^0. Poses are perturbed on the LEFT,
 //   T <- exp(delta) T (rsvio/lie/lie.h); a, b and the twist additively.
-// - Normal-equation block of a keyframe (StateLayout): pose [0, 6), affine (a, b) [6, 8), twist [8, 14)
-//   when rolling. Blocks are ordered as the window (oldest first). IMU velocity/bias blocks and a global
-//   scale-gravity block will follow the same pattern (appended after the twist / after all keyframes).
+// - Normal-equation blocks (StateLayout), n keyframes in window order (oldest first):
+//     [ photometric block of kf 0 .. n-1 ][ inertial block of kf 0 .. n-1 ][ global block ]
+//   photometric block (kfDim()): pose [0, 6), affine (a, b) [6, 8), twist [8, 14) when rolling;
+//   inertial block (kImuDim = 9, visual-inertial only): IMU velocity v in W_m [0, 3), gyro bias [3, 6),
+//   accelerometer bias [6, 9) (additive); global block (globalDim()): T_Wm_Wf as (omega; sigma), LEFT
+//   perturbation of RxSO3 (sigma = log scale) [0, 4), then the camera-IMU time offset in seconds [4]
+//   when it is estimated. The points couple only to photometric blocks, so the photometric kernels
+//   keep their fixed block size; a keyframe's full state (stateDim(): photometric then inertial) is
+//   contiguous in the marginalisation prior.
 // - A point is hosted by a keyframe at an integer level-0 pixel (u, v) of its RAW image, with the unit
 //   bearing of that pixel and its inverse depth rho = 1 / distance along the bearing; it is fixed in
 //   the world at the host row's capture time (rs_projection.h, "host-frame points").
@@ -23,25 +29,57 @@
 
 #include "rsvio/frontend/candidate_points.h"
 #include "rsvio/interfaces/motion_prior.h"
+#include "rsvio/lie/rxso3.h"
 #include "rsvio/lie/se3.h"
 #include "rsvio/photometric/image_pyramid.h"
 #include "rsvio/photometric/photometric_residual.h"
 
 namespace rsvio {
 
+class ImuFactor;
+
 struct KeyframeState {
   SE3d T_c_w;                 // central pose, camera from world (W_f)
   AffineBrightness affine;
   Vec6 twist = Vec6::Zero();  // per second; optimised only with a rolling shutter
+  // Visual-inertial only: IMU velocity in the metric world W_m [m/s], biases [rad/s], [m/s^2].
+  Vec3 v_wm = Vec3::Zero();
+  Vec3 bias_gyro = Vec3::Zero();
+  Vec3 bias_accel = Vec3::Zero();
 };
 
-// Layout of one keyframe's block of the normal equations.
+// The window's global states (visual-inertial only): the scale-gravity transform T_Wm_Wf (paper eq. 2,
+// p_Wm = s R_g p_Wf) and the camera-IMU time offset t_imu = t_cam + time_offset_s (Kalibr's sign).
+struct GlobalState {
+  RxSO3d T_wm_wf;
+  double time_offset_s = 0.0;
+};
+
+struct GlobalStates {
+  GlobalState state, backup, lin;  // as KeyframeState: current, LM backup, frozen linearisation point
+  bool in_prior = false;           // the marginalisation prior has the global block
+};
+
+// Layout of the normal equations (see the contract).
 struct StateLayout {
   static constexpr int kPose = 0;
   static constexpr int kAffine = 6;
   static constexpr int kTwist = 8;
+  static constexpr int kImuDim = 9;
+  static constexpr int kVel = 0, kBiasGyro = 3, kBiasAccel = 6;  // inside the inertial block
+  static constexpr int kGlobalRot = 0, kGlobalScale = 3, kGlobalOffset = 4;  // inside the global block
   bool rolling = false;
-  int kfDim() const { return rolling ? 14 : 8; }
+  bool inertial = false;
+  bool estimate_time_offset = false;  // inertial only
+  int kfDim() const { return rolling ? 14 : 8; }  // photometric block
+  int imuDim() const { return inertial ? kImuDim : 0; }
+  int stateDim() const { return kfDim() + imuDim(); }  // a keyframe's full state
+  int globalDim() const { return inertial ? (estimate_time_offset ? 5 : 4) : 0; }
+  // Offsets in the window system of n keyframes.
+  int photometricOffset(int k) const { return k * kfDim(); }
+  int imuOffset(int k, int n) const { return n * kfDim() + k * kImuDim; }
+  int globalOffset(int n) const { return n * (kfDim() + imuDim()); }
+  int windowDim(int n) const { return n * stateDim() + globalDim(); }
 };
 
 // kIn: used; kOob: the projection left the image or failed; kOutlier: energy above the outlier energy.
@@ -100,6 +138,15 @@ struct Keyframe {
   bool motion_term = false;
   Keyframe* motion_prev = nullptr;
   Keyframe* motion_next = nullptr;
+  // Visual-inertial terms (backend/inertial_term.h): the IMU factor from imu_prev to this keyframe,
+  // preintegrated over [imu_prev->t_ns, t_ns] (camera clock), active while imu_term is set; the
+  // gyroscope reading at this keyframe's time for its twist energy (paper eq. 33), active while
+  // twist_energy is set. Both are switched off once the terms went into the marginalisation prior.
+  bool imu_term = false;
+  Keyframe* imu_prev = nullptr;
+  std::shared_ptr<const ImuFactor> imu_factor;
+  bool twist_energy = false;
+  Vec3 gyro_at_t = Vec3::Zero();
 
   std::vector<ActivePoint> points;         // active points hosted here
   std::vector<CandidatePoint> candidates;  // waiting for activation (frontend/candidate_points.h)
@@ -118,11 +165,20 @@ inline void reindex(KeyframeList& window) {
   for (size_t i = 0; i < window.size(); ++i) window[i]->index = static_cast<int>(i);
 }
 
-// Perturbation of a keyframe's state from its linearisation point, in the block layout:
-// pose log(T T_lin^-1) (left), affine a - a_lin, b - b_lin, twist xi - xi_lin.
+// Perturbation of a keyframe's full state (stateDim(): photometric block, then inertial block) from its
+// linearisation point: pose log(T T_lin^-1) (left), affine a - a_lin, b - b_lin, twist xi - xi_lin,
+// v - v_lin, b_g - b_g,lin, b_a - b_a,lin.
 Eigen::VectorXd stateDelta(const KeyframeState& x, const KeyframeState& lin, const StateLayout& layout);
 
-// Applies a block step (layout order) to a state: T <- exp(d) T, a += d, b += d, xi += d.
+// Applies a full-state step (stateDim(), the order above): T <- exp(d) T, the rest additive.
 void applyStep(KeyframeState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout);
+
+// The same for the global block (globalDim()): T_Wm_Wf <- exp(omega, sigma) T_Wm_Wf, offset additive;
+// the delta is log(T T_lin^-1).
+Eigen::VectorXd globalDelta(const GlobalState& x, const GlobalState& lin, const StateLayout& layout);
+void applyGlobalStep(GlobalState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout);
+
+// A keyframe's full state step gathered from the window system (photometric and inertial blocks).
+Eigen::VectorXd gatherState(const Eigen::VectorXd& x_win, int k, int n, const StateLayout& layout);
 
 }  // namespace rsvio

@@ -14,6 +14,9 @@
 // - smoothMotionInformation(): the information of the smooth-motion prior inside the window
 //   optimisation (backend/smooth_motion_term.h: the twist tied to the optimised poses of its
 //   neighbour keyframes, DSO-RS); returns false if this prior has none.
+// - twistEnergySigma(): the metric standard deviations of the IMU twist energy inside the window
+//   optimisation (paper eq. 33's Sigma; backend/inertial_term.h), translation in m/s and rotation in
+//   rad/s; returns false if this prior has none. Used by visual-inertial runs with a rolling shutter.
 #pragma once
 #include <vector>
 
@@ -55,6 +58,7 @@ class MotionPrior : public PluginBase {
     return false;
   }
   virtual bool smoothMotionInformation(Mat6* /*information*/) const { return false; }
+  virtual bool twistEnergySigma(double* /*sigma_trans_m_s*/, double* /*sigma_rot_rad_s*/) const { return false; }
 };
 
 }  // namespace rsvio

@@ -22,7 +22,7 @@
 
 #include "rsvio/plugin/plugin.h"
 
-#define RSVIO_PLUGIN_ABI_VERSION 1u
+#define RSVIO_PLUGIN_ABI_VERSION 2u  // 2: MotionPrior::twistEnergySigma
 #define RSVIO_PLUGIN_API_VERSION 1u
 
 extern "C" {

@@ -1,0 +1,44 @@
+// Options of the visual-inertial estimator: the "imu" section of a run config (paper sec. IV; the
+// window terms are backend/inertial_term.h, the initialisation imu/vi_init.h). Without "enabled" the
+// run is visual odometry and the dataset's IMU is ignored (said so in the run summary).
+//
+// Weights are eq. 34's alpha (IMU factors) and beta (twist energy, rolling shutter with motion.imu);
+// the twist energy's Sigma comes from the motion.imu plugin (MotionPrior::twistEnergySigma).
+// inertialParamTable() is the one table that validation, listings and docs use.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include "rsvio/plugin/plugin.h"
+
+namespace rsvio {
+
+struct InertialOptions {
+  bool enabled = false;                 // visual-inertial estimation
+  double imu_weight = 1.0;              // alpha of eq. 34
+  double twist_weight = 1.0;            // beta of eq. 34
+  bool estimate_time_offset = false;    // camera-IMU time offset online (t_imu = t_cam + offset)
+  // Visual-inertial initialisation (vi_init.h), tried at every new keyframe until it succeeds.
+  int init_min_keyframes = 8;
+  double init_min_duration_s = 1.5;
+  double init_min_accel_excitation_m_s2 = 0.25;
+  double init_max_gravity_norm_error = 0.1;
+  double accel_bias_prior_sigma_m_s2 = 0.1;  // zero-mean prior on b_a in the initialisation's refinement
+  // Re-preintegrate an IMU factor when the bias moved further than this from its linearisation.
+  double repreintegrate_gyro_bias_rad_s = 0.01;
+  double repreintegrate_accel_bias_m_s2 = 0.1;
+  // Divergence (the run ends "failed" with the reason).
+  double fail_max_gyro_bias_rad_s = 0.5;
+  double fail_max_accel_bias_m_s2 = 3.0;
+  double fail_max_scale_change = 5.0;   // scale vs the initialisation's, either way
+  double fail_max_imu_chi2 = 1e4;       // mean whitened IMU factor energy per factor in the window
+
+  static InertialOptions fromParams(const Params& p);
+};
+
+ParamTable inertialParamTable();
+
+// Reads the "imu" section of an effective config with defaults filled in; problems throw ConfigError
+// naming each key.
+InertialOptions inertialOptionsFromConfig(const nlohmann::json& effective_config);
+
+}  // namespace rsvio

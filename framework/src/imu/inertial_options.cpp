@@ -1,0 +1,79 @@
+// The "imu" section: parameter table and reading (contract in rsvio/imu/inertial_options.h).
+#include "rsvio/imu/inertial_options.h"
+
+#include "rsvio/config/validate.h"
+#include "rsvio/core/error.h"
+
+namespace rsvio {
+
+ParamTable inertialParamTable() {
+  const InertialOptions d;
+  return {
+      paramBool("enabled", d.enabled,
+                "visual-inertial estimation: IMU factors, metric scale and gravity, velocities and biases "
+                "(needs a dataset with an IMU)"),
+      paramDouble("imu_weight", d.imu_weight, 0.0, 1e6, "", "weight alpha of the IMU factors (paper eq. 34)"),
+      paramDouble("twist_weight", d.twist_weight, 0.0, 1e6, "",
+                  "weight beta of the twist energy (paper eq. 34; rolling shutter with motion.imu)"),
+      paramBool("estimate_time_offset", d.estimate_time_offset,
+                "estimate the camera-IMU time offset online (t_imu = t_cam + offset, Kalibr's sign); starts "
+                "from the calibration's"),
+      paramInt("init_min_keyframes", d.init_min_keyframes, 3, 1000, "",
+               "keyframes before the visual-inertial initialisation is tried"),
+      paramDouble("init_min_duration_s", d.init_min_duration_s, 0.0, 1e6, "s",
+                  "time the initialisation's keyframes must span"),
+      paramDouble("init_min_accel_excitation_m_s2", d.init_min_accel_excitation_m_s2, 0.0, 1e3, "m/s^2",
+                  "spread of the mean accelerations the initialisation needs (VINS-Mono: 0.25)"),
+      paramDouble("init_max_gravity_norm_error", d.init_max_gravity_norm_error, 0.0, 1.0, "",
+                  "the linear estimate of |g| must lie within this fraction of 9.81"),
+      paramDouble("accel_bias_prior_sigma_m_s2", d.accel_bias_prior_sigma_m_s2, 1e-6, 1e3, "m/s^2",
+                  "zero-mean prior on the accelerometer bias in the initialisation"),
+      paramDouble("repreintegrate_gyro_bias_rad_s", d.repreintegrate_gyro_bias_rad_s, 0.0, 10.0, "rad/s",
+                  "re-preintegrate an IMU factor when the gyro bias moved further from its linearisation"),
+      paramDouble("repreintegrate_accel_bias_m_s2", d.repreintegrate_accel_bias_m_s2, 0.0, 100.0, "m/s^2",
+                  "re-preintegrate an IMU factor when the accelerometer bias moved further"),
+      paramDouble("fail_max_gyro_bias_rad_s", d.fail_max_gyro_bias_rad_s, 0.0, 1e6, "rad/s",
+                  "the run fails when a gyro bias estimate exceeds this (bias runaway)"),
+      paramDouble("fail_max_accel_bias_m_s2", d.fail_max_accel_bias_m_s2, 0.0, 1e6, "m/s^2",
+                  "the run fails when an accelerometer bias estimate exceeds this (bias runaway)"),
+      paramDouble("fail_max_scale_change", d.fail_max_scale_change, 1.0, 1e12, "",
+                  "the run fails when the scale changes by more than this factor from its initial estimate"),
+      paramDouble("fail_max_imu_chi2", d.fail_max_imu_chi2, 0.0, 1e300, "",
+                  "the run fails when the mean whitened energy of the window's IMU factors exceeds this "
+                  "(exploding IMU residuals; a consistent factor has about 15)"),
+  };
+}
+
+InertialOptions InertialOptions::fromParams(const Params& p) {
+  InertialOptions o;
+  o.enabled = p.getBool("enabled");
+  o.imu_weight = p.getDouble("imu_weight");
+  o.twist_weight = p.getDouble("twist_weight");
+  o.estimate_time_offset = p.getBool("estimate_time_offset");
+  o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));
+  o.init_min_duration_s = p.getDouble("init_min_duration_s");
+  o.init_min_accel_excitation_m_s2 = p.getDouble("init_min_accel_excitation_m_s2");
+  o.init_max_gravity_norm_error = p.getDouble("init_max_gravity_norm_error");
+  o.accel_bias_prior_sigma_m_s2 = p.getDouble("accel_bias_prior_sigma_m_s2");
+  o.repreintegrate_gyro_bias_rad_s = p.getDouble("repreintegrate_gyro_bias_rad_s");
+  o.repreintegrate_accel_bias_m_s2 = p.getDouble("repreintegrate_accel_bias_m_s2");
+  o.fail_max_gyro_bias_rad_s = p.getDouble("fail_max_gyro_bias_rad_s");
+  o.fail_max_accel_bias_m_s2 = p.getDouble("fail_max_accel_bias_m_s2");
+  o.fail_max_scale_change = p.getDouble("fail_max_scale_change");
+  o.fail_max_imu_chi2 = p.getDouble("fail_max_imu_chi2");
+  return o;
+}
+
+InertialOptions inertialOptionsFromConfig(const nlohmann::json& effective_config) {
+  const nlohmann::json section = effective_config.contains("imu") ? effective_config.at("imu") : nlohmann::json::object();
+  std::vector<ConfigProblem> problems;
+  const nlohmann::json filled = validateParams(section, inertialParamTable(), "imu", problems);
+  if (!problems.empty()) {
+    std::string msg = "imu: " + std::to_string(problems.size()) + " problem(s)";
+    for (const ConfigProblem& p : problems) msg += "\n" + p.str();
+    throw ConfigError(msg);
+  }
+  return InertialOptions::fromParams(Params(filled, "imu"));
+}
+
+}  // namespace rsvio
