@@ -13,6 +13,7 @@
 #include "rsvio/imu/imu_buffer.h"
 #include "rsvio/imu/preintegration.h"
 #include "rsvio/imu/twist_prior.h"
+#include "rsvio/imu/visual_inertial_factor.h"
 #include "support/numeric_jacobian.h"
 
 namespace rsvio {
