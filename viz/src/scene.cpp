@@ -252,6 +252,7 @@ std::vector<std::string> renderScenes(const io::Snapshot& s, const SceneOptions&
       overlay(makeText(grid_note, static_cast<int>(font * 0.75), Rgb{120, 120, 120}, sw - font * 1.2, H - font * 0.5, true, true));
     }
     win->Render();
+    keepGlDriverLoaded();  // sanitizer build only (vtk_helpers.h)
     if (!errors->message_.empty()) throw Error("VTK could not render: " + errors->message_);
     const std::string path = (fs::path(out_dir) / (o.file_prefix + viewName(v) + ".png")).string();
     writePng(win, path, W, H);

@@ -17,10 +17,16 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <cmath>
+#include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "rsvio/core/error.h"
+
+#ifdef RSVIO_SANITIZE
+#include <dlfcn.h>
+#include <link.h>
+#endif
 
 namespace rsvio::viz::detail {
 namespace {
@@ -207,6 +213,22 @@ void writePng(vtkRenderWindow* win, const std::string& path, int width, int heig
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
   cv::flip(bgr, bgr, 0);  // VTK's rows start at the bottom
   if (!cv::imwrite(path, bgr)) throw Error(path + ": could not write PNG");
+}
+
+void keepGlDriverLoaded() {
+#ifdef RSVIO_SANITIZE
+  std::vector<std::string> drivers;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void* out) {
+        const char* n = info->dlpi_name;
+        const size_t len = n ? std::strlen(n) : 0;
+        if (len > 7 && std::strcmp(n + len - 7, "_dri.so") == 0) static_cast<std::vector<std::string>*>(out)->push_back(n);
+        return 0;
+      },
+      &drivers);
+  // RTLD_NOLOAD: only takes a reference on what is loaded already; RTLD_NODELETE: never unloaded.
+  for (const auto& d : drivers) dlopen(d.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+#endif
 }
 
 }  // namespace rsvio::viz::detail

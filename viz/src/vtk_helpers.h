@@ -49,5 +49,10 @@ vtkSmartPointer<vtkActor2D> make2DLine(const std::vector<Eigen::Vector2d>& pts, 
 std::string wrap(const std::string& s, size_t width);
 // Reads the rendered window back and writes it as PNG; throws rsvio::Error on a size mismatch or I/O error.
 void writePng(vtkRenderWindow* win, const std::string& path, int width, int height);
+// Sanitizer build only (RSVIO_SANITIZE; no-op otherwise): marks the GL driver modules loaded so far
+// (Mesa's *_dri.so, dlopen'ed per X display and dlclose'd when the window's display closes) as never
+// to be unloaded. Unloaded, the driver's globals are unmapped: LeakSanitizer then reports what they
+// pointed to as leaks from "<unknown module>" that no suppression can name. Call after a Render().
+void keepGlDriverLoaded();
 
 }  // namespace rsvio::viz::detail
