@@ -1,0 +1,277 @@
+// The inertial part of the estimator (contract in inertial_state.h).
+#include "inertial_state.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "rsvio/core/time.h"
+#include "rsvio/imu/imu_factor.h"
+#include "rsvio/imu/imu_frames.h"
+#include "rsvio/imu/preintegration.h"
+#include "rsvio/imu/twist_prior.h"
+
+namespace rsvio {
+
+namespace {
+constexpr double kBufferS = 60.0;               // IMU history kept (initialisation and the window)
+constexpr double kRepreintegrateOffsetS = 1e-3; // re-preintegrate when the offset moved further
+}  // namespace
+
+InertialState::InertialState(const InertialOptions& o, const SensorSetup& sensors, bool rolling,
+                             double twist_sigma_trans_m_s, double twist_sigma_rot_rad_s)
+    : o_(o),
+      sensors_(sensors),
+      rolling_(rolling),
+      twist_sigma_t_(twist_sigma_trans_m_s),
+      twist_sigma_r_(twist_sigma_rot_rad_s),
+      T_cm_i_(cameraFromImu(sensors.camera.T_B_C)),
+      buffer_(5'000'000) {
+  globals_.state.time_offset_s = sensors.camera.time_offset_s;
+  InertialTermOptions to;
+  to.imu_weight = o.imu_weight;
+  to.twist_weight = o.twist_weight;
+  if (twist_sigma_t_ > 0.0) to.twist_sigma_trans_m_s = twist_sigma_t_;
+  if (twist_sigma_r_ > 0.0) to.twist_sigma_rot_rad_s = twist_sigma_r_;
+  term_ = std::make_unique<InertialTerm>(to, T_cm_i_, &globals_);
+}
+
+int64_t InertialState::offsetNs() const { return sToNs(globals_.state.time_offset_s); }
+
+void InertialState::addImu(const ImuSample& s) {
+  buffer_.add(s);
+  buffer_.dropBefore(s.t_ns - sToNs(kBufferS));
+}
+
+SE3d InertialState::bodyPose(const SE3d& T_cf_wf) const {
+  return imuPoseFromCamera(T_cf_wf, globals_.state.T_wm_wf, T_cm_i_);
+}
+
+std::shared_ptr<const ImuFactor> InertialState::makeFactor(const Keyframe& from, const Keyframe& to) const {
+  const int64_t off = offsetNs();
+  if (!(to.t_ns > from.t_ns) || !buffer_.covers(from.t_ns + off, to.t_ns + off)) return nullptr;
+  ImuBias b;
+  b.gyro = from.state.bias_gyro;
+  b.accel = from.state.bias_accel;
+  return std::make_shared<ImuFactor>(ImuPreintegration::fromBuffer(buffer_, from.t_ns, to.t_ns, sensors_.imu, b,
+                                                                   globals_.state.time_offset_s));
+}
+
+void InertialState::linkTwistEnergy(Keyframe& kf) const {
+  kf.twist_energy = false;
+  if (!rolling_ || !(twist_sigma_t_ > 0.0) || !(twist_sigma_r_ > 0.0)) return;
+  const int64_t t = kf.t_ns + offsetNs();
+  if (!buffer_.covers(t, t)) return;
+  kf.gyro_at_t = buffer_.interpolate(t).gyro_rad_s;
+  kf.twist_energy = true;
+}
+
+std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
+  kf.imu_term = false;
+  kf.imu_prev = nullptr;
+  kf.imu_factor.reset();
+  if (!initialised_ || !newest) return "";
+  // Start at the prediction of the newest keyframe's state, then link the factor at that bias.
+  kf.state.bias_gyro = newest->state.bias_gyro;
+  kf.state.bias_accel = newest->state.bias_accel;
+  kf.state.v_wm = newest->state.v_wm;
+  std::shared_ptr<const ImuFactor> f = makeFactor(*newest, kf);
+  if (!f) {
+    std::ostringstream os;
+    os << "no IMU data between keyframes at " << nsToS(newest->t_ns) << " s and " << nsToS(kf.t_ns)
+       << " s: the new keyframe has no IMU factor";
+    linkTwistEnergy(kf);
+    return os.str();
+  }
+  ImuState si;
+  setPose(&si, imuPoseFromCamera(newest->state.T_c_w, globals_.state.T_wm_wf, T_cm_i_));
+  si.v_w = newest->state.v_wm;
+  si.bias = f->preintegration().biasLin();
+  kf.state.v_wm = predictState(si, f->preintegration()).v_w;
+  kf.imu_prev = newest;
+  kf.imu_factor = f;
+  kf.imu_term = true;
+  linkTwistEnergy(kf);
+  if (kf.twist_energy)  // the IMU's twist (eq. 32) is a better start than the visual guess
+    kf.state.twist = imuTwistPrior(kf.gyro_at_t, kf.state.v_wm, kf.state.bias_gyro, kf.state.T_c_w,
+                                   globals_.state.T_wm_wf, T_cm_i_);
+  return "";
+}
+
+bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, KeyframeList& window,
+                                  BundleAdjuster& ba, MarginalizationPrior& prior) {
+  if (!o_.enabled || initialised_ || window.empty()) return false;
+  const int64_t off = offsetNs();
+  std::vector<ViInitKeyframe> kfs;
+  for (const ViInitKeyframe& k : keyframes)
+    if (buffer_.covers(k.t_ns + off, k.t_ns + off)) kfs.push_back(k);
+  if (static_cast<int>(kfs.size()) < o_.init_min_keyframes) {
+    std::ostringstream os;
+    os << "waiting for keyframes with IMU data: " << kfs.size() << " < imu.init_min_keyframes "
+       << o_.init_min_keyframes;
+    status_ = os.str();
+    return false;
+  }
+  ViInitOptions vo;
+  vo.min_keyframes = o_.init_min_keyframes;
+  vo.min_duration_s = o_.init_min_duration_s;
+  vo.min_accel_excitation_m_s2 = o_.init_min_accel_excitation_m_s2;
+  vo.max_gravity_norm_error = o_.init_max_gravity_norm_error;
+  vo.accel_bias_prior_sigma_m_s2 = o_.accel_bias_prior_sigma_m_s2;
+  const ViInitResult r = initializeVisualInertial(kfs, buffer_, sensors_.imu, T_cm_i_, globals_.state.time_offset_s, vo);
+  if (!r.success) {
+    status_ = r.status;
+    return false;
+  }
+  globals_.state.T_wm_wf = r.T_wm_wf;
+  scale_init_ = r.T_wm_wf.scale();
+  for (auto& kf : window) {
+    kf->state.bias_gyro = r.bias.gyro;
+    kf->state.bias_accel = r.bias.accel;
+    for (size_t i = 0; i < kfs.size(); ++i)
+      if (kfs[i].t_ns == kf->t_ns) kf->state.v_wm = r.velocities_wm[i];
+  }
+  initialised_ = true;
+  for (size_t k = 0; k < window.size(); ++k) {
+    Keyframe& kf = *window[k];
+    kf.imu_term = false;
+    kf.imu_prev = nullptr;
+    kf.imu_factor.reset();
+    if (k > 0) {
+      std::shared_ptr<const ImuFactor> f = makeFactor(*window[k - 1], kf);
+      if (f) {
+        kf.imu_prev = window[k - 1].get();
+        kf.imu_factor = f;
+        kf.imu_term = true;
+      }
+    }
+    linkTwistEnergy(kf);
+  }
+  BundleAdjustmentConfig cfg = ba.config();
+  cfg.layout.inertial = true;
+  cfg.layout.estimate_time_offset = o_.estimate_time_offset;
+  ba.setConfig(cfg);
+  ba.setGlobals(&globals_);
+  prior.setGlobals(&globals_);
+  prior.setLayout(cfg.layout);
+  for (auto& kf : window)
+    if (kf->in_prior) {  // the prior has no information on these yet: any linearisation point is exact
+      kf->lin.v_wm = kf->state.v_wm;
+      kf->lin.bias_gyro = kf->state.bias_gyro;
+      kf->lin.bias_accel = kf->state.bias_accel;
+    }
+  std::ostringstream os;
+  os << "initialised: scale " << scale_init_ << " m per unit, gravity aligned, b_g |" << r.bias.gyro.norm()
+     << "| rad/s, b_a |" << r.bias.accel.norm() << "| m/s^2, " << kfs.size() << " keyframes over " << r.duration_s
+     << " s";
+  status_ = os.str();
+  return true;
+}
+
+void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& window, MarginalizationPrior& prior) const {
+  if (!initialised_) return;
+  const StateLayout layout = prior.layout();
+  std::vector<Keyframe*> kfs;
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  term_->linearizeInvolving(leaving, window, layout, &kfs, &H, &b);
+  if (!kfs.empty()) {
+    // Fixed dimensions must be zero in the prior's terms (marginalization.h): the gauge keyframe's pose
+    // and affine, and the yaw of T_Wm_Wf.
+    const int d = layout.stateDim();
+    std::vector<Eigen::Index> zero;
+    for (size_t i = 0; i < kfs.size(); ++i)
+      if (kfs[i]->gauge)
+        for (int r = 0; r < 8; ++r) zero.push_back(static_cast<Eigen::Index>(i) * d + r);
+    zero.push_back(static_cast<Eigen::Index>(kfs.size()) * d + StateLayout::kGlobalRot + 2);
+    for (Eigen::Index z : zero) {
+      H.row(z).setZero();
+      H.col(z).setZero();
+      b[z] = 0.0;
+    }
+    prior.addTerm(kfs, H, b, true);
+  }
+  leaving.imu_term = false;
+  leaving.twist_energy = false;
+  leaving.imu_prev = nullptr;
+  leaving.imu_factor.reset();
+  for (const auto& w : window)
+    if (w->imu_prev == &leaving) {
+      w->imu_term = false;
+      w->imu_prev = nullptr;
+      w->imu_factor.reset();
+    }
+}
+
+void InertialState::refreshFactors(KeyframeList& window) {
+  if (!initialised_) return;
+  for (auto& kf : window) {
+    if (!kf->imu_term || !kf->imu_prev || !kf->imu_factor) continue;
+    const ImuPreintegration& p = kf->imu_factor->preintegration();
+    const Keyframe& i = *kf->imu_prev;
+    const bool moved = (i.state.bias_gyro - p.biasLin().gyro).norm() > o_.repreintegrate_gyro_bias_rad_s ||
+                       (i.state.bias_accel - p.biasLin().accel).norm() > o_.repreintegrate_accel_bias_m_s2 ||
+                       std::abs(globals_.state.time_offset_s - p.timeOffsetLin()) > kRepreintegrateOffsetS;
+    if (!moved) continue;
+    std::shared_ptr<const ImuFactor> f = makeFactor(i, *kf);
+    if (f) kf->imu_factor = f;
+  }
+}
+
+std::string InertialState::checkDivergence(const KeyframeList& window) const {
+  if (!initialised_) return "";
+  std::ostringstream os;
+  const double s = scale();
+  if (!std::isfinite(s) || s > scale_init_ * o_.fail_max_scale_change || s < scale_init_ / o_.fail_max_scale_change) {
+    os << "scale collapse: scale " << s << " against " << scale_init_
+       << " at the visual-inertial initialisation (imu.fail_max_scale_change " << o_.fail_max_scale_change << ")";
+    return os.str();
+  }
+  double chi2 = 0.0;
+  int n = 0;
+  for (const auto& kf : window) {
+    const double bg = kf->state.bias_gyro.norm(), ba = kf->state.bias_accel.norm();
+    if (!std::isfinite(bg) || bg > o_.fail_max_gyro_bias_rad_s) {
+      os << "gyroscope bias runaway: |b_g| " << bg << " rad/s at keyframe " << kf->kf_id
+         << " > imu.fail_max_gyro_bias_rad_s " << o_.fail_max_gyro_bias_rad_s;
+      return os.str();
+    }
+    if (!std::isfinite(ba) || ba > o_.fail_max_accel_bias_m_s2) {
+      os << "accelerometer bias runaway: |b_a| " << ba << " m/s^2 at keyframe " << kf->kf_id
+         << " > imu.fail_max_accel_bias_m_s2 " << o_.fail_max_accel_bias_m_s2;
+      return os.str();
+    }
+    double e = 0.0;
+    if (term_->imuResidual(*kf, nullptr, &e)) {
+      chi2 += e;
+      ++n;
+    }
+  }
+  if (n > 0 && !(chi2 / n <= o_.fail_max_imu_chi2)) {
+    os << "exploding IMU residuals: mean whitened energy " << chi2 / n << " per factor > imu.fail_max_imu_chi2 "
+       << o_.fail_max_imu_chi2;
+    return os.str();
+  }
+  return "";
+}
+
+void InertialState::fillMotionState(const Keyframe& ref, MotionState* ms) const {
+  if (!initialised_) return;
+  ms->has_inertial = true;
+  ms->T_wm_wf = SE3d(globals_.state.T_wm_wf.so3(), Vec3::Zero());
+  ms->scale = scale();
+  ms->bias_gyro = ref.state.bias_gyro;
+  ms->bias_accel = ref.state.bias_accel;
+  ms->v_wm = ref.state.v_wm;
+  const int64_t off = offsetNs();
+  if (ms->t_ns <= ref.t_ns || !buffer_.covers(ref.t_ns + off, ms->t_ns + off)) return;
+  ImuState si;
+  setPose(&si, imuPoseFromCamera(ref.state.T_c_w, globals_.state.T_wm_wf, T_cm_i_));
+  si.v_w = ref.state.v_wm;
+  si.bias.gyro = ref.state.bias_gyro;
+  si.bias.accel = ref.state.bias_accel;
+  const ImuPreintegration pre = ImuPreintegration::fromBuffer(buffer_, ref.t_ns, ms->t_ns, sensors_.imu, si.bias,
+                                                              globals_.state.time_offset_s);
+  ms->v_wm = predictState(si, pre).v_w;
+}
+
+}  // namespace rsvio

@@ -1,0 +1,98 @@
+// The inertial part of the estimator (paper sec. IV, Fig. 3): the IMU buffer, the global states
+// T_Wm_Wf and time offset, each keyframe's IMU factor and twist energy, the visual-inertial
+// initialisation and the inertial divergence tests. Odometry composes it with the window; it never
+// reads ground truth.
+//
+// Owns and keeps true
+// - Before initialised(): the run is visual odometry; keyframes carry no inertial terms and the
+//   window's layout has no inertial blocks. tryInitialize() (at each new keyframe, on the run's
+//   keyframe poses so far) either keeps it so and records why (status()), or sets T_Wm_Wf, every
+//   window keyframe's velocity and biases, links IMU factors between consecutive window keyframes and
+//   switches the bundle adjuster and the prior to the inertial layout, once.
+// - After: every keyframe entering the window gets the IMU factor from the newest keyframe and, with a
+//   rolling shutter and an IMU twist Sigma, its twist energy; velocity, biases and twist start at the
+//   IMU's prediction. A keyframe's terms go into the marginalisation prior before it leaves
+//   (marginalizeTerms), so no term refers to a keyframe that left.
+// - Times: keyframe stamps are camera times (middle row); IMU samples are picked at
+//   t_imu = t_cam + time offset (Kalibr's sign), the current estimate when it is estimated.
+// - The IMU buffer keeps the last buffer_s seconds (bounded memory on long runs).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rsvio/backend/bundle_adjustment.h"
+#include "rsvio/backend/inertial_term.h"
+#include "rsvio/backend/marginalization.h"
+#include "rsvio/backend/window.h"
+#include "rsvio/imu/imu_buffer.h"
+#include "rsvio/imu/inertial_options.h"
+#include "rsvio/imu/vi_init.h"
+#include "rsvio/interfaces/motion_prior.h"
+
+namespace rsvio {
+
+class InertialState {
+ public:
+  // twist_sigma_*: the IMU twist energy's Sigma (MotionPrior::twistEnergySigma); <= 0: no twist energy.
+  InertialState(const InertialOptions& o, const SensorSetup& sensors, bool rolling, double twist_sigma_trans_m_s,
+                double twist_sigma_rot_rad_s);
+
+  bool enabled() const { return o_.enabled; }
+  bool initialised() const { return initialised_; }
+  const std::string& status() const { return status_; }  // why it is not initialised yet (or "initialised")
+  const InertialOptions& options() const { return o_; }
+
+  void addImu(const ImuSample& s);
+
+  // A keyframe enters the window; `newest` is the newest keyframe before it (null: none). After the
+  // initialisation: links its IMU factor and twist energy and starts its inertial state at the IMU's
+  // prediction from `newest`. Returns a warning when the IMU does not cover the interval ("" if fine).
+  std::string onNewKeyframe(Keyframe& kf, Keyframe* newest);
+
+  // Tries the visual-inertial initialisation (see the contract) with the keyframe poses of the run so
+  // far (time order, T_Cf_Wf). Returns true when it succeeded now.
+  bool tryInitialize(const std::vector<ViInitKeyframe>& keyframes, KeyframeList& window, BundleAdjuster& ba,
+                     MarginalizationPrior& prior);
+
+  // Before `leaving` leaves the window: its terms (and the factor from it) into the prior, switched off.
+  void marginalizeTerms(Keyframe& leaving, const KeyframeList& window, MarginalizationPrior& prior) const;
+
+  // After an optimisation: re-preintegrates the factors whose bias or offset moved too far.
+  void refreshFactors(KeyframeList& window);
+  // "" or the reason the estimate diverged (bias runaway, scale collapse, exploding IMU residuals).
+  std::string checkDivergence(const KeyframeList& window) const;
+
+  // The inertial part of a tracked frame's motion state, propagated from keyframe `ref` to t_ns.
+  void fillMotionState(const Keyframe& ref, MotionState* ms) const;
+
+  const WindowTerm* term() const { return initialised_ ? term_.get() : nullptr; }
+  const InertialTerm* inertialTerm() const { return term_.get(); }
+  GlobalStates& globals() { return globals_; }
+  const GlobalStates& globals() const { return globals_; }
+  double scale() const { return globals_.state.T_wm_wf.scale(); }
+  double timeOffset() const { return globals_.state.time_offset_s; }
+  double initialScale() const { return scale_init_; }
+  const SE3d& T_cm_i() const { return T_cm_i_; }
+  // The metric body pose T_Wm_B of a camera pose T_Cf_Wf with the current T_Wm_Wf.
+  SE3d bodyPose(const SE3d& T_cf_wf) const;
+
+ private:
+  std::shared_ptr<const ImuFactor> makeFactor(const Keyframe& from, const Keyframe& to) const;
+  void linkTwistEnergy(Keyframe& kf) const;
+  int64_t offsetNs() const;
+
+  InertialOptions o_;
+  SensorSetup sensors_;
+  bool rolling_ = false;
+  double twist_sigma_t_ = 0.0, twist_sigma_r_ = 0.0;
+  SE3d T_cm_i_;
+  ImuBuffer buffer_;
+  GlobalStates globals_;
+  std::unique_ptr<InertialTerm> term_;
+  bool initialised_ = false;
+  double scale_init_ = 1.0;
+  std::string status_ = "waiting for keyframes";
+};
+
+}  // namespace rsvio
