@@ -1,7 +1,7 @@
 // The estimator behind `rsvio run` (contract in rsvio/system/odometry.h): set-up from the effective
-// config, the per-frame loop (preprocess, track, trace candidates, keyframe decision) and the results.
-// Keyframes and points: odometry_keyframe.cpp; monocular start: odometry_init.cpp; outputs:
-// odometry_output.cpp.
+// config, the per-frame loop (preprocess, track, trace candidates, keyframe decision), the monocular
+// start's hand-over, a keyframe's steps in DSO's order, finish() and the results. The parts it
+// composes are listed in odometry_impl.h.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -64,19 +64,14 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
 
   timing = RowTiming::from(*shutter, *camera);
   rolling = shutter->isRolling();
-  BundleAdjustmentConfig bc;
+  WindowSetup ws;
+  BundleAdjustmentConfig& bc = ws.ba;
   for (const PhotometricModel* p : photometric_ptrs)
     if (p->hasAffineBrightness()) {
       estimate_affine = true;
       bc.affine_prior_a = p->affinePriorA();
       bc.affine_prior_b = p->affinePriorB();
     }
-  TrackerOptions to = fo.track;
-  to.residual = fo.residual;
-  to.estimate_a = to.estimate_b = estimate_affine;
-  to.threads = threads;
-  tracker = std::make_unique<FrameTracker>(to, *camera, timing);
-  tracer = std::make_unique<CandidateTracer>(fo.trace, fo.residual, *camera, timing);
   bc.layout.rolling = rolling;
   bc.residual = fo.residual;
   bc.estimate_affine = estimate_affine;
@@ -84,26 +79,28 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   bc.step_threshold = bo.step_threshold;
   bc.twist_regularization = bo.twist_regularization;
   bc.threads = threads;
-  ba = std::make_unique<BundleAdjuster>(bc, *camera, timing, *solver);
-  if (rolling) {
-    Mat6 info;
+  if (rolling)
     for (const auto& m : motion)
-      if (m->smoothMotionInformation(&info)) {
-        SmoothMotionOptions so;
-        so.information = info;
-        smooth_motion = std::make_unique<SmoothMotionTerm>(so);
-        ba->setTerms({smooth_motion.get()});
+      if (m->smoothMotionInformation(&ws.smooth_motion_information)) {
+        ws.smooth_motion = true;
         break;
       }
-  }
-  prior = std::make_unique<MarginalizationPrior>(bc.layout);
-  initializer = std::make_unique<MonoInitializer>(bo, *camera);
-  min_act_dist = bo.activation_min_dist_px;
-  diag.width = sensors.camera.width;
-  diag.height = sensors.camera.height;
-  diag.line_delay_s = rolling ? timing.line_delay_s : 0.0;
+  ws.backend = bo;
+  ws.frontend = fo;
+  ws.seed = seed;
+
+  record = std::make_unique<RunRecord>(*camera, timing, rolling, estimate_affine, sensors.camera);
+  TrackerOptions to = fo.track;
+  to.residual = fo.residual;
+  to.estimate_a = to.estimate_b = estimate_affine;
+  to.threads = threads;
+  std::vector<const MotionPrior*> motion_ptrs;
+  for (const auto& m : motion) motion_ptrs.push_back(m.get());
+  tracking = std::make_unique<Tracking>(to, *camera, timing, motion_ptrs);
+  window = std::make_unique<KeyframeWindow>(ws, *camera, timing, *solver);
+  start = std::make_unique<MonoStart>(bo, *camera);
   if (sensors.has_imu)
-    warnings.push_back("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
+    record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
 }
 
 void Odometry::Impl::fail(const std::string& reason) {
@@ -112,53 +109,8 @@ void Odometry::Impl::fail(const std::string& reason) {
   failure = reason;
 }
 
-Vec6 Odometry::Impl::velocityEstimate() const {
-  if (history.size() < 2) return Vec6::Zero();
-  const MotionState& a = history[history.size() - 2];
-  const MotionState& b = history.back();
-  const double dt = nsToS(b.t_ns - a.t_ns);
-  if (!(std::abs(dt) > 1e-9)) return Vec6::Zero();
-  return (b.T_c_w * a.T_c_w.inverse()).log() / dt;
-}
-
-// The twist of a new frame (rolling shutter), held fixed by the tracker:
-// rotation from the frame-to-frame velocity of the last two tracked frames, translation from the
-// newest keyframe's optimised twist. Tracking determines rotation well over one frame interval, but
-// its translation over 50 ms is noisy (demo sequence: +-0.3 m/s against 0.6 m/s of motion), and a
-// twist's translation is nearly unobservable by the tracker itself; the window's twist is held by
-// the smooth-motion term (smooth_motion_term.h). Measured on the demo sequence (rs_vo, true line
-// delay, docs/rolling_shutter.md): frame-to-frame twist 71 mm ATE, this mix 14 mm. The candidate
-// tracer and a new keyframe's starting twist keep the frame-to-frame velocity (the same mix there
-// measured 89 and 18 mm on that sequence).
-Vec6 Odometry::Impl::frameTwistGuess() const {
-  Vec6 xi = velocityEstimate();
-  if (!window.empty()) xi.head<3>() = window.back()->state.twist.head<3>();
-  return xi;
-}
-
-void Odometry::Impl::pushHistory(const FrameRecord& f) {
-  MotionState s;
-  s.t_ns = f.t_ns;
-  s.T_c_w = f.T_c_w;
-  s.is_keyframe = f.keyframe;
-  history.push_back(s);
-  if (history.size() > 2) history.back().twist = velocityEstimate();
-  constexpr size_t kHistory = 32;
-  if (history.size() > kHistory) history.erase(history.begin(), history.begin() + (history.size() - kHistory));
-}
-
-std::vector<SE3d> Odometry::Impl::guesses(int64_t t_ns) const {
-  std::vector<SE3d> out;
-  for (const auto& m : motion) {
-    const std::vector<SE3d> g = m->predict(history, t_ns);
-    out.insert(out.end(), g.begin(), g.end());
-  }
-  if (out.empty() && !history.empty()) out.push_back(history.back().T_c_w);
-  return out;
-}
-
 FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr) {
-  const Keyframe& ref = *window.back();
+  const Keyframe& ref = window->newest();
   FrameRecord rec;
   rec.index = frame.index;
   rec.t_ns = frame.t_ns;
@@ -166,50 +118,233 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   TrackingFrame info;
   info.t_ns = frame.t_ns;
   info.exposure_ms = frame.exposure_ms;
-  info.twist = rolling ? frameTwistGuess() : Vec6::Zero();
-  info.affine_guess = frames.empty() ? ref.state.affine : frames.back().affine;
+  info.twist = rolling ? tracking->frameTwistGuess(&ref) : Vec6::Zero();
+  info.affine_guess = record->frames().empty() ? ref.state.affine : record->frames().back().affine;
   TrackResult r;
+  bool ok = false;
   {
-    ScopedStage st(stages, "track");
-    r = tracker->track(*pyr, info, guesses(frame.t_ns));
+    ScopedStage st(record->stages(), "track");
+    r = tracking->track(*pyr, info, &ok);
   }
-  if (!r.ok() || !r.T_c_w.translation().allFinite()) {
-    frames.push_back(rec);
-    ++lost_in_row;
+  if (!ok) {
+    record->addFrame(rec);
     std::ostringstream os;
     os << "tracking lost at frame " << frame.index << " (t " << io::formatSeconds(frame.t_ns) << " s): " << r.reason;
-    if (lost_in_row > bo.max_lost_frames) fail(os.str());
+    if (tracking->lostInRow() > bo.max_lost_frames) fail(os.str());
     return FrameStatus{false, false, "tracking lost: " + r.reason};
   }
-  lost_in_row = 0;
-  if (std::isnan(first_rmse)) first_rmse = r.rmse;
   rec.tracked = true;
   rec.T_c_w = r.T_c_w;
   rec.affine = r.affine;
   rec.ref_kf_id = ref.kf_id;
   rec.T_f_ref = r.T_c_w * ref.state.T_c_w.inverse();
-  frames.push_back(rec);
-  pushHistory(rec);
+  record->addFrame(rec);
+  tracking->pushHistory(rec.t_ns, rec.T_c_w, rec.keyframe);
   {
-    ScopedStage st(stages, "trace");
-    traceCandidates(*pyr, r.T_c_w, r.affine, frame.exposure_ms);
+    ScopedStage st(record->stages(), "trace");
+    CandidateFrame target;
+    target.pose = RsFrame{r.T_c_w, rolling ? tracking->velocityEstimate() : Vec6::Zero()};
+    target.affine = r.affine;
+    target.exposure_ms = frame.exposure_ms;
+    window->traceCandidates(target, pyr->level(0));
   }
   KeyframeCue cue;
   cue.flow_t_px = r.flow_t_px;
   cue.flow_rt_px = r.flow_rt_px;
   cue.log_brightness_ratio = logBrightnessRatio(ref.state.affine, ref.exposure_ms, r.affine, frame.exposure_ms);
   cue.rmse = r.rmse;
-  cue.first_rmse = first_rmse;
+  cue.first_rmse = tracking->firstRmse();
   cue.seconds_since_keyframe = nsToS(frame.t_ns - ref.t_ns);
   cue.width = camera->width();
   cue.height = camera->height();
   std::string why;
   if (!needKeyframe(bo, cue, &why)) return FrameStatus{true, false, "tracked"};
   {
-    ScopedStage st(stages, "keyframe");
+    ScopedStage st(record->stages(), "keyframe");
     makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, std::move(pyr), r.T_c_w, r.affine);
   }
   return FrameStatus{true, true, failed ? "failed: " + failure : "keyframe (" + why + ")"};
+}
+
+// DSO's makeKeyFrame order (Engel et al. 2018, sec. 3): flag keyframes to marginalise, add the keyframe
+// and every active point's observation in it, activate candidates, optimise the window, set the
+// tracking reference, remove outliers and marginalise leaving points, create the new keyframe's
+// candidates, marginalise the flagged keyframes, check for divergence.
+void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms,
+                                  std::shared_ptr<const ImagePyramid> pyr, const SE3d& T_c_w,
+                                  const AffineBrightness& affine) {
+  const std::vector<Keyframe*> flagged = window->keyframesToMarginalize();
+  auto kf = std::make_unique<Keyframe>();
+  kf->frame_index = frame_index;
+  kf->t_ns = t_ns;
+  kf->exposure_ms = exposure_ms;
+  kf->pyramid = std::move(pyr);
+  kf->state.T_c_w = T_c_w;
+  kf->state.affine = affine;
+  if (rolling) {
+    kf->state.twist = tracking->velocityEstimate();
+    kf->twist_start = kf->state.twist;
+    MotionState ms;
+    ms.t_ns = t_ns;
+    ms.T_c_w = T_c_w;
+    ms.twist = kf->state.twist;
+    ms.is_keyframe = true;
+    TwistPrior tp;
+    if (tracking->twistPrior(ms, &tp)) {
+      kf->has_twist_prior = true;
+      kf->twist_prior = tp;
+    }
+  }
+  Keyframe& nk = window->insert(std::move(kf));
+  {
+    ScopedStage st(record->stages(), "activate");
+    window->activateCandidates(nk);
+  }
+  {
+    ScopedStage st(record->stages(), "optimise");
+    window->optimize(bo.max_iterations);
+  }
+  for (const auto& k : window->keyframes()) record->recordKeyframe(*k);
+  if (FrameRecord* f = record->frame(frame_index)) {
+    f->keyframe = true;
+    f->tracked = true;
+    f->ref_kf_id = nk.kf_id;
+    f->T_f_ref = SE3d();
+    f->T_c_w = nk.state.T_c_w;
+    f->affine = nk.state.affine;
+  }
+  tracking->keyframeOptimised(t_ns, nk.state.T_c_w);
+  tracking->setReference(window->trackingReference(nk));
+  {
+    ScopedStage st(record->stages(), "marginalise");
+    window->removeOutliersAndMarginalizePoints(nk, *record);
+  }
+  window->createCandidates(nk);
+  {
+    ScopedStage st(record->stages(), "marginalise");
+    for (Keyframe* f : flagged) window->marginalizeKeyframe(f, *record);
+  }
+  checkDivergence();
+}
+
+void Odometry::Impl::checkDivergence() {
+  if (failed || window->size() < 2) return;
+  std::string warning;
+  const std::string reason = window->divergence(&warning);
+  if (!warning.empty()) record->addWarning(warning);
+  if (!reason.empty()) fail(reason);
+}
+
+// Monocular start (mono_start.h): corner tracks until a two-view pose with parallax is found, then the
+// reference frame becomes the first keyframe (the gauge), its candidates are traced into the current
+// frame, the current frame becomes the second keyframe through the ordinary keyframe path (activation,
+// bundle adjustment), and the frames in between are tracked against it.
+FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr,
+                                       const cv::Mat& working) {
+  bool done = false;
+  {
+    ScopedStage st(record->stages(), "initialise");
+    done = start->addFrame(frame, pyr, working);
+  }
+  FrameRecord rec;
+  rec.index = frame.index;
+  rec.t_ns = frame.t_ns;
+  rec.exposure_ms = frame.exposure_ms;
+  if (!done) {
+    record->addFrame(rec);
+    const int64_t first = record->frames().front().index;
+    if (frame.index - first + 1 >= bo.init_max_frames) {
+      std::ostringstream os;
+      os << "monocular initialisation failed after " << (frame.index - first + 1) << " frames: " << start->status();
+      fail(os.str());
+      return FrameStatus{false, false, "failed: " + failure};
+    }
+    return FrameStatus{false, false, "initialising: " + start->status()};
+  }
+
+  // The reference frame becomes keyframe 0 with the identity pose.
+  ScopedStage st(record->stages(), "initialise");
+  const MonoStart::StartFrame ref = start->reference();
+  const SE3d T_cur_ref = start->T_cur_ref();
+  if (FrameRecord* r = record->frame(ref.index)) {
+    r->tracked = true;
+    r->T_c_w = SE3d();
+  }
+  tracking->pushHistory(ref.t_ns, SE3d(), false);
+  auto kf0 = std::make_unique<Keyframe>();
+  kf0->frame_index = ref.index;
+  kf0->t_ns = ref.t_ns;
+  kf0->exposure_ms = ref.exposure_ms;
+  kf0->pyramid = ref.pyramid;
+  Keyframe& k0 = window->insert(std::move(kf0));  // the first keyframe: the gauge
+  if (FrameRecord* r = record->frame(ref.index)) {
+    r->keyframe = true;
+    r->ref_kf_id = k0.kf_id;
+  }
+  window->createCandidates(k0);
+  CandidateFrame target;
+  target.pose = RsFrame{T_cur_ref, Vec6::Zero()};
+  target.exposure_ms = frame.exposure_ms;
+  window->traceCandidates(target, pyr->level(0));
+  record->recordKeyframe(k0);
+
+  // The current frame: a tracked frame that becomes keyframe 1.
+  rec.tracked = true;
+  rec.T_c_w = T_cur_ref;
+  rec.ref_kf_id = k0.kf_id;
+  rec.T_f_ref = T_cur_ref;
+  record->addFrame(rec);
+  tracking->pushHistory(rec.t_ns, rec.T_c_w, rec.keyframe);
+  makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, pyr, T_cur_ref, AffineBrightness());
+  initialized = true;
+  if (failed) return FrameStatus{false, true, "failed: " + failure};
+
+  // Frames between the two keyframes: tracked against keyframe 1 from poses interpolated in time.
+  const SE3d T1 = window->newest().state.T_c_w;
+  const int64_t kf1_id = window->newest().kf_id;
+  const Vec6 log_rel = T1.log();  // keyframe 0 is the identity
+  const double span = nsToS(frame.t_ns - ref.t_ns);
+  for (const MonoStart::StartFrame& f : start->frames()) {
+    if (f.index == ref.index || f.index == frame.index || f.working.empty()) continue;
+    const ImagePyramid p(f.working, fo.pyramid_levels);
+    TrackingFrame info;
+    info.t_ns = f.t_ns;
+    info.exposure_ms = f.exposure_ms;
+    const double s = span > 0 ? nsToS(f.t_ns - ref.t_ns) / span : 0.5;
+    const TrackResult r = tracking->trackFrom(p, info, {SE3d::exp(log_rel * s)});
+    if (!r.ok()) continue;
+    if (FrameRecord* fr = record->frame(f.index)) {
+      fr->tracked = true;
+      fr->T_c_w = r.T_c_w;
+      fr->affine = r.affine;
+      fr->ref_kf_id = kf1_id;
+      fr->T_f_ref = r.T_c_w * T1.inverse();
+    }
+  }
+  start->clear();
+  tracking->resetFirstRmse();
+  std::ostringstream os;
+  os << "initialised (" << start->status() << ")";
+  return FrameStatus{true, true, os.str()};
+}
+
+void Odometry::Impl::finish() {
+  if (!initialized && !failed) {
+    // The sequence ended before the monocular start succeeded: nothing was estimated, and saying
+    // "ok" would hide it.
+    std::ostringstream os;
+    os << "monocular initialisation did not succeed in the " << record->frames().size()
+       << " frames of the sequence: " << start->status();
+    fail(os.str());
+  }
+  if (window->empty()) return;
+  if (!failed && window->size() >= 2) {
+    ScopedStage st(record->stages(), "optimise");
+    window->optimize(bo.max_iterations);
+  }
+  window->evaluate();
+  for (const auto& kf : window->keyframes()) record->recordFinal(*kf);
+  window->releasePoints(*record);
 }
 
 Odometry::Odometry(const nlohmann::json& effective_config, PluginHost& host, const SensorSetup& sensors)
@@ -235,7 +370,7 @@ FrameStatus Odometry::addFrame(const Frame& frame) {
     cv::Mat working;
     std::shared_ptr<const ImagePyramid> pyr;
     {
-      ScopedStage st(m.stages, "preprocess");
+      ScopedStage st(m.record->stages(), "preprocess");
       working = prepareWorkingImage(frame, m.photometric_ptrs);
       pyr = std::make_shared<ImagePyramid>(working, m.fo.pyramid_levels);
     }
@@ -249,13 +384,22 @@ FrameStatus Odometry::addFrame(const Frame& frame) {
   }
 }
 
+void Odometry::finish() { impl_->finish(); }
+
 bool Odometry::failed() const { return impl_->failed; }
 std::string Odometry::failureReason() const { return impl_->failure; }
-std::map<std::string, double> Odometry::stageMs() const { return impl_->stages.means(); }
-long Odometry::numKeyframes() const { return static_cast<long>(impl_->keyframes.size()); }
+std::map<std::string, double> Odometry::stageMs() const { return impl_->record->stages().means(); }
+long Odometry::numKeyframes() const { return impl_->record->numKeyframes(); }
 bool Odometry::usesImu() const { return false; }
 double Odometry::scale() const { return 1.0; }
-std::vector<std::string> Odometry::warnings() const { return impl_->warnings; }
-const DiagnosticsLog& Odometry::diagnostics() const { return impl_->diag; }
+std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }
+const DiagnosticsLog& Odometry::diagnostics() const { return impl_->record->diagnostics(); }
+
+io::Trajectory Odometry::frameTrajectory() const { return impl_->record->frameTrajectory(impl_->window->keyframes()); }
+io::Trajectory Odometry::keyframeTrajectory() const {
+  return impl_->record->keyframeTrajectory(impl_->window->keyframes());
+}
+std::vector<MapPoint> Odometry::points() const { return impl_->record->points(impl_->window->keyframes()); }
+std::vector<StateRow> Odometry::states() const { return impl_->record->states(impl_->window->keyframes()); }
 
 }  // namespace rsvio

@@ -1,0 +1,185 @@
+// The run record (contract in run_record.h): frame and keyframe records, map points, diagnostics rows,
+// and the outputs written from them (trajectories, points, states).
+#include "run_record.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rsvio/core/time.h"
+
+namespace rsvio {
+namespace {
+
+io::StampedPose stamped(int64_t t_ns, const SE3d& T_c_w) {
+  const SE3d T_w_c = T_c_w.inverse();
+  io::StampedPose p;
+  p.t_ns = t_ns;
+  p.p_W_X = T_w_c.translation();
+  p.q_W_X = T_w_c.unit_quaternion();
+  return p;
+}
+
+}  // namespace
+
+
+RunRecord::RunRecord(const CameraModel& camera, const RowTiming& timing, bool rolling, bool estimate_affine,
+                     const CameraCalibration& calibration)
+    : camera_(camera), timing_(timing), rolling_(rolling), estimate_affine_(estimate_affine) {
+  diag_.width = calibration.width;
+  diag_.height = calibration.height;
+  diag_.line_delay_s = rolling ? timing.line_delay_s : 0.0;
+}
+
+FrameRecord* RunRecord::frame(int64_t index) {
+  for (auto it = frames_.rbegin(); it != frames_.rend(); ++it)
+    if (it->index == index) return &*it;
+  return nullptr;
+}
+
+void RunRecord::recordFinal(Keyframe& kf) {
+  observedTwist(kf);
+  recordKeyframe(kf);
+}
+
+void RunRecord::recordKeyframe(const Keyframe& kf) {
+  KeyframeRecord& r = keyframes_[kf.kf_id];
+  r.kf_id = kf.kf_id;
+  r.frame_index = kf.frame_index;
+  r.t_ns = kf.t_ns;
+  r.state = kf.state;
+  if (!rolling_ && kf.has_observed_twist) r.state.twist = kf.observed_twist;
+}
+
+// Twist of a keyframe seen from the poses of its neighbouring frames (per second), for global-shutter
+// runs where the state has none: the central difference of the previous and next tracked frames.
+Vec6 RunRecord::observedTwist(Keyframe& kf) const {
+  if (kf.has_observed_twist) return kf.observed_twist;
+  const FrameRecord* prev = nullptr;
+  const FrameRecord* next = nullptr;
+  const FrameRecord* self = nullptr;
+  for (const FrameRecord& f : frames_) {
+    if (!f.tracked) continue;
+    if (f.index < kf.frame_index) prev = &f;
+    if (f.index == kf.frame_index) self = &f;
+    if (f.index > kf.frame_index) {
+      next = &f;
+      break;
+    }
+  }
+  const FrameRecord* a = prev ? prev : self;
+  const FrameRecord* b = next ? next : self;
+  if (!a || !b || a == b) return Vec6::Zero();
+  const double dt = nsToS(b->t_ns - a->t_ns);
+  if (!(dt > 0)) return Vec6::Zero();
+  const Vec6 xi = (b->T_c_w * a->T_c_w.inverse()).log() / dt;
+  if (next && prev) {
+    kf.observed_twist = xi;
+    kf.has_observed_twist = true;
+  }
+  return xi;
+}
+
+void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation& o) {
+  if (!(o.state == ObsState::kIn)) return;
+  const Keyframe& host = *p.host;
+  Keyframe& target = *o.target;
+  ObservationRow r;
+  r.t_ns = target.t_ns;
+  r.frame = static_cast<int32_t>(target.frame_index);
+  r.host = static_cast<int32_t>(host.frame_index);
+  r.u = o.u;
+  r.v = o.v;
+  r.row = static_cast<float>(o.v - timing_.y0);
+  const CameraCalibration& c = camera_.calibration();
+  const double half_diag = 0.5 * std::hypot(c.width, c.height);
+  r.radius = static_cast<float>(std::hypot(o.u - c.intrinsics[2], o.v - c.intrinsics[3]) / half_diag);
+  r.intensity = p.pattern.color[kPatternCentre];
+  r.grad_u = o.grad_u;
+  r.grad_v = o.grad_v;
+  // Pixel velocity d uv / dt = J_cam (xi_v + xi_w x P), P the point in the target camera.
+  const Vec6 xi = rolling_ ? target.state.twist : observedTwist(target);
+  Vec3 Z = p.bearing / p.idepth;
+  if (rolling_) Z = SE3d::exp(-host.state.twist * timing_.rowTime(p.v)) * Z;
+  const Vec3 X = host.state.T_c_w.inverse() * Z;
+  const double t = timing_.rowTime(o.v);
+  const Vec3 P = SE3d::exp(xi * t) * (target.state.T_c_w * X);
+  Vec2 uv;
+  Jac23 J;
+  if (camera_.project(P, uv, &J)) {
+    const Vec2 vel = J * (xi.head<3>() + xi.tail<3>().cross(P));
+    r.vel_u = static_cast<float>(vel.x());
+    r.vel_v = static_cast<float>(vel.y());
+  }
+  r.residual = o.mean_residual;
+  r.weight = o.mean_weight;
+  const double exp_ratio =
+      (host.exposure_ms > 0 && target.exposure_ms > 0) ? target.exposure_ms / host.exposure_ms : 1.0;
+  r.exposure_ratio =
+      static_cast<float>(estimate_affine_ ? exp_ratio * std::exp(target.state.affine.a - host.state.affine.a) : 1.0);
+  diag_.observations.push_back(r);
+}
+
+void RunRecord::pointLeaves(const ActivePoint& p) {
+  const Vec3 X = pointInWorld(p, timing_, rolling_);
+  if (!X.allFinite()) return;
+  map_points_.push_back(MapPoint{X.cast<float>(), p.pattern.color[kPatternCentre]});
+}
+
+io::Trajectory RunRecord::frameTrajectory(const KeyframeList& window) const {
+  io::Trajectory t;
+  t.frame = io::PoseFrame::kCamera;
+  for (const FrameRecord& f : frames_) {
+    if (!f.tracked) continue;
+    SE3d T = f.T_c_w;
+    const auto it = keyframes_.find(f.ref_kf_id);
+    if (it != keyframes_.end()) T = f.T_f_ref * it->second.state.T_c_w;
+    // A keyframe still in the window: its current state.
+    for (const auto& kf : window)
+      if (kf->kf_id == f.ref_kf_id) T = f.T_f_ref * kf->state.T_c_w;
+    t.poses.push_back(stamped(f.t_ns, T));
+  }
+  std::stable_sort(t.poses.begin(), t.poses.end(),
+                   [](const io::StampedPose& a, const io::StampedPose& b) { return a.t_ns < b.t_ns; });
+  return t;
+}
+
+io::Trajectory RunRecord::keyframeTrajectory(const KeyframeList& window) const {
+  io::Trajectory t;
+  t.frame = io::PoseFrame::kCamera;
+  std::map<int64_t, SE3d> by_time;
+  for (const auto& [id, r] : keyframes_) by_time[r.t_ns] = r.state.T_c_w;
+  for (const auto& kf : window) by_time[kf->t_ns] = kf->state.T_c_w;
+  for (const auto& [ts, T] : by_time) t.poses.push_back(stamped(ts, T));
+  return t;
+}
+
+std::vector<MapPoint> RunRecord::points(const KeyframeList& window) const {
+  std::vector<MapPoint> out = map_points_;
+  for (const auto& kf : window)
+    for (const ActivePoint& p : kf->points) {
+      const Vec3 X = pointInWorld(p, timing_, rolling_);
+      if (X.allFinite()) out.push_back(MapPoint{X.cast<float>(), p.pattern.color[kPatternCentre]});
+    }
+  return out;
+}
+
+std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
+  std::map<int64_t, StateRow> rows;
+  for (const auto& [id, r] : keyframes_) {
+    StateRow s;
+    s.t_ns = r.t_ns;
+    s.twist = r.state.twist;
+    rows[r.t_ns] = s;
+  }
+  for (const auto& kf : window) {
+    StateRow s;
+    s.t_ns = kf->t_ns;
+    s.twist = rolling_ ? kf->state.twist : (kf->has_observed_twist ? kf->observed_twist : Vec6::Zero());
+    rows[kf->t_ns] = s;
+  }
+  std::vector<StateRow> out;
+  for (const auto& [t, s] : rows) out.push_back(s);
+  return out;
+}
+
+}  // namespace rsvio

@@ -1,0 +1,110 @@
+// The run record of rsvio::Odometry: everything its outputs and diagnostics are written from
+// (trajectory.tum, keyframes.tum, points.ply, states.csv, diagnostics.bin, report.json's stage times
+// and warnings; conventions.md "Outputs").
+//
+// Owns
+// - one FrameRecord per input frame in arrival order (untracked ones too), with the keyframe it was
+//   tracked against and its pose relative to it;
+// - one KeyframeRecord per keyframe of the run, by kf_id: the state it was last recorded with (for a
+//   marginalised keyframe its final one);
+// - the map points that left the window, the diagnostics log (one row per inlier observation when it
+//   leaves the window, io/diagnostics_log.h), the stage times and the run's warnings.
+//
+// Invariants
+// - Frame indices are unique (sequence positions). Records are only appended, except that a frame's
+//   record is refined when it becomes a keyframe or is tracked after the monocular start, and a
+//   keyframe's record whenever its keyframe is optimised again.
+// - It sees the window only through what it is given: it is the window's WindowSink (what leaves
+//   arrives in the order it leaves) and the outputs take the live window, whose keyframes and points
+//   are reported with their current state in place of their records.
+// - A global-shutter keyframe's recorded twist is its observed twist (central difference of the
+//   neighbouring frames' poses) once the next frame is tracked; a rolling shutter's is its state's.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "keyframe_window.h"
+#include "rsvio/interfaces/camera.h"
+#include "rsvio/io/diagnostics_log.h"
+#include "rsvio/io/states.h"
+#include "rsvio/io/trajectory.h"
+#include "rsvio/system/odometry.h"
+#include "stage_times.h"
+
+namespace rsvio {
+
+// One input frame as the estimator remembers it.
+struct FrameRecord {
+  int64_t index = 0;
+  int64_t t_ns = 0;
+  bool tracked = false;
+  bool keyframe = false;
+  int64_t ref_kf_id = -1;     // the keyframe it was tracked against (itself for a keyframe)
+  SE3d T_f_ref;               // camera of this frame from the camera of the reference keyframe
+  SE3d T_c_w;                 // as estimated when tracked (keyframes: updated by their optimisation)
+  AffineBrightness affine;
+  double exposure_ms = std::numeric_limits<double>::quiet_NaN();
+};
+
+// A keyframe's latest (for marginalised ones: final) state.
+struct KeyframeRecord {
+  int64_t kf_id = 0;
+  int64_t frame_index = 0;
+  int64_t t_ns = 0;
+  KeyframeState state;
+};
+
+class RunRecord : public WindowSink {
+ public:
+  // camera and timing must outlive the record; calibration: the diagnostics log's image size.
+  RunRecord(const CameraModel& camera, const RowTiming& timing, bool rolling, bool estimate_affine,
+            const CameraCalibration& calibration);
+
+  // Frames.
+  void addFrame(const FrameRecord& f) { frames_.push_back(f); }
+  FrameRecord* frame(int64_t index);  // the record of that frame, or nullptr
+  const std::vector<FrameRecord>& frames() const { return frames_; }
+
+  // Keyframes: the current state of a keyframe (its twist: see the invariants).
+  void recordKeyframe(const Keyframe& kf);
+  // The observed twist is computed (and cached in kf once both neighbours are tracked), then recorded.
+  void recordFinal(Keyframe& kf);
+  long numKeyframes() const { return static_cast<long>(keyframes_.size()); }
+
+  // WindowSink: what leaves the window.
+  void observationLeaves(const ActivePoint& p, const ActiveObservation& o) override;
+  void pointLeaves(const ActivePoint& p) override;
+  void keyframeLeaves(Keyframe& kf) override { recordFinal(kf); }
+
+  StageTimes& stages() { return stages_; }
+  const StageTimes& stages() const { return stages_; }
+  void addWarning(const std::string& w) { warnings_.push_back(w); }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  const DiagnosticsLog& diagnostics() const { return diag_; }
+
+  // Outputs, with the keyframes and points still in `window` at their current state.
+  io::Trajectory frameTrajectory(const KeyframeList& window) const;     // refined frame poses
+  io::Trajectory keyframeTrajectory(const KeyframeList& window) const;
+  std::vector<MapPoint> points(const KeyframeList& window) const;
+  std::vector<StateRow> states(const KeyframeList& window) const;
+
+ private:
+  // Twist of a keyframe seen from its neighbouring tracked frames (global shutter), per second.
+  Vec6 observedTwist(Keyframe& kf) const;
+
+  const CameraModel& camera_;
+  const RowTiming& timing_;
+  bool rolling_ = false;
+  bool estimate_affine_ = false;
+  std::vector<FrameRecord> frames_;
+  std::map<int64_t, KeyframeRecord> keyframes_;  // by kf_id, every keyframe of the run
+  std::vector<MapPoint> map_points_;             // points that left the window (marginalised)
+  DiagnosticsLog diag_;
+  StageTimes stages_;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace rsvio

@@ -1,0 +1,97 @@
+// Tracking (contract in tracking.h): the tracker's calls, the lost counter and the motion history.
+#include "tracking.h"
+
+#include "rsvio/core/time.h"
+
+namespace rsvio {
+
+Tracking::Tracking(const TrackerOptions& options, const CameraModel& camera, const RowTiming& timing,
+                   std::vector<const MotionPrior*> motion)
+    : tracker_(std::make_unique<FrameTracker>(options, camera, timing)), motion_(std::move(motion)) {}
+
+TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok) {
+  TrackResult r = tracker_->track(pyr, info, guesses(info.t_ns));
+  *ok = r.ok() && r.T_c_w.translation().allFinite();
+  if (!*ok) {
+    ++lost_in_row_;
+    return r;
+  }
+  lost_in_row_ = 0;
+  if (std::isnan(first_rmse_)) first_rmse_ = r.rmse;
+  return r;
+}
+
+TrackResult Tracking::trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses) {
+  return tracker_->track(pyr, info, guesses);
+}
+
+void Tracking::setReference(const TrackingReference& reference) {
+  tracker_->setReference(reference);
+  first_rmse_ = std::nan("");
+}
+
+Vec6 Tracking::velocityEstimate() const {
+  if (history_.size() < 2) return Vec6::Zero();
+  const MotionState& a = history_[history_.size() - 2];
+  const MotionState& b = history_.back();
+  const double dt = nsToS(b.t_ns - a.t_ns);
+  if (!(std::abs(dt) > 1e-9)) return Vec6::Zero();
+  return (b.T_c_w * a.T_c_w.inverse()).log() / dt;
+}
+
+// The twist of a new frame (rolling shutter), held fixed by the tracker:
+// rotation from the frame-to-frame velocity of the last two tracked frames, translation from the
+// newest keyframe's optimised twist. Tracking determines rotation well over one frame interval, but
+// its translation over 50 ms is noisy (demo sequence: +-0.3 m/s against 0.6 m/s of motion), and a
+// twist's translation is nearly unobservable by the tracker itself; the window's twist is held by
+// the smooth-motion term (smooth_motion_term.h). Measured on the demo sequence (rs_vo, true line
+// delay, docs/rolling_shutter.md): frame-to-frame twist 71 mm ATE, this mix 14 mm. The candidate
+// tracer and a new keyframe's starting twist keep the frame-to-frame velocity (the same mix there
+// measured 89 and 18 mm on that sequence).
+Vec6 Tracking::frameTwistGuess(const Keyframe* newest) const {
+  Vec6 xi = velocityEstimate();
+  if (newest) xi.head<3>() = newest->state.twist.head<3>();
+  return xi;
+}
+
+void Tracking::pushHistory(int64_t t_ns, const SE3d& T_c_w, bool is_keyframe) {
+  MotionState s;
+  s.t_ns = t_ns;
+  s.T_c_w = T_c_w;
+  s.is_keyframe = is_keyframe;
+  history_.push_back(s);
+  if (history_.size() > 2) history_.back().twist = velocityEstimate();
+  constexpr size_t kHistory = 32;
+  if (history_.size() > kHistory) history_.erase(history_.begin(), history_.begin() + (history_.size() - kHistory));
+}
+
+void Tracking::keyframeOptimised(int64_t t_ns, const SE3d& T_c_w) {
+  for (MotionState& s : history_)
+    if (s.t_ns == t_ns) {
+      s.T_c_w = T_c_w;
+      s.is_keyframe = true;
+    }
+}
+
+std::vector<SE3d> Tracking::guesses(int64_t t_ns) const {
+  std::vector<SE3d> out;
+  for (const MotionPrior* m : motion_) {
+    const std::vector<SE3d> g = m->predict(history_, t_ns);
+    out.insert(out.end(), g.begin(), g.end());
+  }
+  if (out.empty() && !history_.empty()) out.push_back(history_.back().T_c_w);
+  return out;
+}
+
+bool Tracking::twistPrior(const MotionState& keyframe, TwistPrior* prior) const {
+  for (const MotionPrior* m : motion_) {
+    TwistPrior tp;  // a fresh one per prior: one that declines leaves nothing behind
+    if (m->twistPrior(history_, keyframe, &tp)) {
+      *prior = tp;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace rsvio

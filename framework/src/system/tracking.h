@@ -1,0 +1,63 @@
+// Tracking of rsvio::Odometry: every frame against the newest keyframe (frontend/frame_tracker.h),
+// from the motion priors' guesses, and the motion history those priors predict from.
+//
+// Owns
+// - the frame tracker and its reference (the newest keyframe's image and the active points seen in
+//   it, set by setReference());
+// - the motion history: the last 32 tracked frames (MotionState, oldest first), a keyframe's entry
+//   with its optimised pose;
+// - the frames lost in a row and the first tracking RMSE since the reference was set (the keyframe
+//   policy's RMSE cue).
+// It uses, not owns, the configured motion priors (motion.* plugins).
+//
+// Invariants
+// - The history is in time order, holds at most 32 frames, and from its third frame on each entry
+//   carries the frame-to-frame twist of its last two (velocityEstimate() when it was added).
+// - The first RMSE is NaN from setReference() until a frame tracks against that reference.
+// - The lost counter is 0 after a tracked frame.
+#pragma once
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "rsvio/backend/window.h"
+#include "rsvio/frontend/frame_tracker.h"
+#include "rsvio/interfaces/camera.h"
+#include "rsvio/interfaces/motion_prior.h"
+
+namespace rsvio {
+
+class Tracking {
+ public:
+  // camera, timing and the motion priors must outlive the tracking.
+  Tracking(const TrackerOptions& options, const CameraModel& camera, const RowTiming& timing,
+           std::vector<const MotionPrior*> motion);
+
+  // Tracks a frame from guesses(); *ok: tracked with a finite pose (else the lost counter grows).
+  TrackResult track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok);
+  // Tracks a frame from given guesses; counters and history untouched (frames of the monocular start).
+  TrackResult trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses);
+  void setReference(const TrackingReference& reference);
+  void resetFirstRmse() { first_rmse_ = std::nan(""); }
+  int lostInRow() const { return lost_in_row_; }
+  double firstRmse() const { return first_rmse_; }
+
+  // Motion history.
+  void pushHistory(int64_t t_ns, const SE3d& T_c_w, bool is_keyframe);
+  void keyframeOptimised(int64_t t_ns, const SE3d& T_c_w);  // the keyframe's entry takes its optimised pose
+  std::vector<SE3d> guesses(int64_t t_ns) const;             // every motion prior's, else the last pose
+  Vec6 velocityEstimate() const;  // per second, from the last two tracked frames (0 without)
+  // Rolling shutter: a new frame's twist (see tracking.cpp); newest: the newest keyframe, or nullptr.
+  Vec6 frameTwistGuess(const Keyframe* newest) const;
+  // The first motion prior's fixed-mean twist prior for a new keyframe, if any has one.
+  bool twistPrior(const MotionState& keyframe, TwistPrior* prior) const;
+
+ private:
+  std::unique_ptr<FrameTracker> tracker_;
+  std::vector<const MotionPrior*> motion_;
+  std::vector<MotionState> history_;
+  int lost_in_row_ = 0;
+  double first_rmse_ = std::nan("");
+};
+
+}  // namespace rsvio
