@@ -9,6 +9,10 @@
 namespace rsvio {
 namespace ba {
 
+// true: every pair through the general projectRollingShutter() (the reference the global-shutter fast
+// path is checked against; switch on to measure it).
+constexpr bool kGeneralProjection = false;
+
 void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleAdjustmentConfig& cfg,
                     const std::vector<ActivePoint*>* only) {
   reindex(window);
@@ -77,6 +81,60 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
 
 namespace {
 
+// [I, -[p]x] (rs_projection.cpp's dLeftAction).
+Eigen::Matrix<double, 3, 6> dLeftAction(const Vec3& p) {
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>().setIdentity();
+  J.rightCols<3>() = -SO3d::hat(p);
+  return J;
+}
+
+// Global shutter (no twists in the layout): projectRollingShutter() of host points at row time 0 with
+// the same arithmetic in the same order, without the factors that are identities there (exp(0), its
+// rotation matrix, the implicit-row correction with a = 0) and without filling its general outputs, so
+// uv and the Jacobians are bit-identical to the general call. Fills valid, uv, d_uv_d_X, d_uv_d_T0,
+// d_uv_d_Th0, d_uv_d_idepth of pw.proj; the twist and line-delay Jacobians are not used by the
+// global-shutter accumulation and are left as they are.
+void projectPairGlobal(const CameraModel& camera, const RsFrame& host, const RsFrame& target, PairWork& pw) {
+  const Eigen::Index n = pw.bearing.cols();
+  pw.proj.resize(static_cast<size_t>(n));
+  const SE3d T_w_h0 = host.T_c_w0.inverse();
+  const Eigen::Matrix3d R_w_h0 = T_w_h0.rotationMatrix();
+  const Eigen::Matrix3d R_t = target.T_c_w0.rotationMatrix();
+  std::vector<int> idx;
+  idx.reserve(static_cast<size_t>(n));
+  Eigen::Matrix3Xd P0(3, n);
+  Eigen::Matrix2Xd uv;
+  std::vector<uint8_t> valid;
+  std::vector<Jac23> J;
+  Eigen::Index m = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    pw.proj[static_cast<size_t>(i)].valid = false;
+    const double rho = pw.idepth[i];
+    if (!(rho > 0.0) || !std::isfinite(rho)) continue;
+    const Vec3 X = T_w_h0 * Vec3(pw.bearing.col(i) / rho);
+    P0.col(m++) = target.T_c_w0 * X;
+    idx.push_back(static_cast<int>(i));
+  }
+  P0.conservativeResize(3, m);
+  camera.project(P0, uv, valid, &J);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const size_t i = static_cast<size_t>(idx[static_cast<size_t>(k)]);
+    RsHostProjection& r = pw.proj[i];
+    r.uv = uv.col(k);
+    r.valid = valid[static_cast<size_t>(k)] != 0;
+    if (!r.valid) continue;
+    const Jac23& Jc = J[static_cast<size_t>(k)];
+    r.d_uv_d_T0 = Jc * dLeftAction(P0.col(k));
+    r.d_uv_d_X = Jc * R_t;
+    const double rho = pw.idepth[static_cast<Eigen::Index>(i)];
+    const Vec3 Z = pw.bearing.col(static_cast<Eigen::Index>(i)) / rho;
+    const Eigen::Matrix<double, 2, 3> d_uv_d_Z = r.d_uv_d_X * R_w_h0;
+    r.d_uv_d_Th0 = -d_uv_d_Z * dLeftAction(Z);
+    r.d_uv_d_idepth = d_uv_d_Z * Vec3(-pw.bearing.col(static_cast<Eigen::Index>(i)) / (rho * rho));
+  }
+}
+
 // Evaluates every observation of one host-target pair.
 void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const BundleAdjustmentConfig& cfg,
                   const CameraModel& camera, const RowTiming& timing, const ResidualKernel& kernel) {
@@ -95,7 +153,10 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   const bool rolling = cfg.layout.rolling;
   RsFrame host{pw.host->state.T_c_w, rolling ? pw.host->state.twist : Vec6::Zero()};
   RsFrame target{pw.target->state.T_c_w, rolling ? pw.target->state.twist : Vec6::Zero()};
-  projectRollingShutter(camera, timing, host, target, pw.bearing, pw.v_h, pw.idepth, pw.proj);
+  if (rolling || kGeneralProjection)
+    projectRollingShutter(camera, timing, host, target, pw.bearing, pw.v_h, pw.idepth, pw.proj);
+  else
+    projectPairGlobal(camera, host, target, pw);
 
   const ImageLevel& img = pw.target->pyramid->level(0);
   const double exposure_ratio = (pw.host->exposure_ms > 0.0 && pw.target->exposure_ms > 0.0)
@@ -107,8 +168,24 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   const Vec3 omega_h = host.xi.tail<3>();
   const float e_out = kernel.outlier_energy;
 
+  // Visit the observations in the order of their target rows (counting sort, stable): the pattern
+  // samples then walk through the target image instead of jumping across its ~5 MB at random. Each
+  // observation's result is written to its own slot, so the order changes no number.
+  const int rows = img.height();
+  std::vector<int> count(static_cast<size_t>(rows) + 2, 0), order(static_cast<size_t>(n));
+  auto rowKey = [&](int k) {
+    const RsHostProjection& pr = pw.proj[static_cast<size_t>(k)];
+    const double y = pr.uv.y();
+    if (!pr.valid || !(y >= 0.0) || !(y < rows)) return rows;  // invalid or outside: last
+    return static_cast<int>(y);
+  };
+  for (int k = 0; k < n; ++k) ++count[static_cast<size_t>(rowKey(k)) + 1];
+  for (int r = 0; r <= rows; ++r) count[static_cast<size_t>(r) + 1] += count[static_cast<size_t>(r)];
+  for (int k = 0; k < n; ++k) order[static_cast<size_t>(count[static_cast<size_t>(rowKey(k))]++)] = k;
+
   PatternResidual res;
-  for (int k = 0; k < n; ++k) {
+  for (int kk = 0; kk < n; ++kk) {
+    const int k = order[static_cast<size_t>(kk)];
     const ObsRef& ref = m.obs_refs[static_cast<size_t>(pw.obs[static_cast<size_t>(k)])];
     const ActivePoint& p = *m.points[static_cast<size_t>(ref.point)];
     ObsLin& ol = L.obs[static_cast<size_t>(pw.obs[static_cast<size_t>(k)])];
@@ -175,10 +252,15 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
             -s_x, -s_y, -s_c, -A * s_w, s_c, s_w;
     ol.g << r_x, r_y, r_c, A * r_1, -r_c, -r_1;
     ol.Jg.block<2, 6>(0, kColHostPose) = pr.d_uv_d_Th0;
-    ol.Jg.block<2, 6>(0, kColHostTwist) = pr.d_uv_d_xi_h;
     ol.Jg.block<2, 6>(0, kColTargetPose) = pr.d_uv_d_T0;
-    ol.Jg.block<2, 6>(0, kColTargetTwist) = pr.d_uv_d_xi;
     ol.Jg.col(kColIdepth) = pr.d_uv_d_idepth;
+    if (rolling) {
+      ol.Jg.block<2, 6>(0, kColHostTwist) = pr.d_uv_d_xi_h;
+      ol.Jg.block<2, 6>(0, kColTargetTwist) = pr.d_uv_d_xi;
+    } else {
+      ol.Jg.block<2, 6>(0, kColHostTwist).setZero();
+      ol.Jg.block<2, 6>(0, kColTargetTwist).setZero();
+    }
   }
 }
 
@@ -189,10 +271,9 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   // inverse depth) is formed compactly: only NG geometric columns (poses, twists when rolling, inverse
   // depth) carry d uv, and the four affine columns are selectors, so
   //   H_gg = G^T M_uu G, H_ga = G^T M_ua, H_aa = M_aa   (G: 2 x NG)
-  // and then scattered into Hl (about 5x fewer products than the dense 6 x N form).
+  // and then scattered into the chunk's blocks (about 5x fewer products than the dense 6 x N form).
   constexpr int N = 2 * KD + 1;
   constexpr int NG = KD == 14 ? 25 : 13;
-  using HL = Eigen::Matrix<double, N, N>;
   using GM = Eigen::Matrix<double, 2, NG>;
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
   cs.H.setZero();
@@ -221,8 +302,6 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   Eigen::Matrix<double, NG, NG> Hgg;
   Eigen::Matrix<double, NG, 4> Hga;
   Eigen::Matrix<double, NG, 1> bg;
-  HL Hl = HL::Zero();
-  Eigen::Matrix<double, N, 1> bl = Eigen::Matrix<double, N, 1>::Zero();
   for (int i = begin; i < end; ++i) {
     const ActivePoint& p = *m.points[static_cast<size_t>(i)];
     const int hb = p.host->index;
@@ -246,28 +325,38 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       Hgg.noalias() = G.transpose().lazyProduct(MG);
       Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
       bg.noalias() = -G.transpose() * ol.g.template head<2>();
-      for (int a = 0; a < NG; ++a) {
-        for (int c = 0; c < NG; ++c) Hl(gidx[a], gidx[c]) = Hgg(a, c);
-        for (int c = 0; c < 4; ++c) Hl(gidx[a], aidx[c]) = Hl(aidx[c], gidx[a]) = Hga(a, c);
-        bl[gidx[a]] = bg[a];
+      // Straight into the chunk's blocks: each entry of the host/target blocks receives the same one
+      // addition per observation as through an N x N staging matrix (bit-identical), without writing
+      // and re-reading that matrix. Local index x < KD is the host block, KD <= x < 2 KD the target's,
+      // 2 KD the inverse depth (kept per point for the Schur complement).
+      int row[N];
+      for (int x = 0; x < KD; ++x) row[x] = hb * KD + x, row[KD + x] = tb * KD + x;
+      double* Hd = cs.H.data();
+      const Eigen::Index ld = cs.H.rows();
+      auto at = [&](int x, int y) -> double& { return Hd[static_cast<Eigen::Index>(row[y]) * ld + row[x]]; };
+      double hcol[N];  // column 2 KD of the local Hessian: d^2 E / d rho d x
+      for (int a = 0; a < NG - 1; ++a) {
+        const int ga = gidx[a];
+        for (int c = 0; c < NG - 1; ++c) at(ga, gidx[c]) += Hgg(a, c);
+        for (int c = 0; c < 4; ++c) {
+          at(ga, aidx[c]) += Hga(a, c);
+          at(aidx[c], ga) += Hga(a, c);
+        }
+        hcol[ga] = Hgg(a, NG - 1);
+        cs.b[row[ga]] += bg[a];
       }
       for (int a = 0; a < 4; ++a) {
-        for (int c = 0; c < 4; ++c) Hl(aidx[a], aidx[c]) = ol.M(2 + a, 2 + c);
-        bl[aidx[a]] = -ol.g[2 + a];
+        for (int c = 0; c < 4; ++c) at(aidx[a], aidx[c]) += ol.M(2 + a, 2 + c);
+        hcol[aidx[a]] = Hga(NG - 1, a);
+        cs.b[row[aidx[a]]] += -ol.g[2 + a];
       }
-      Hpp += Hl(2 * KD, 2 * KD);
-      bp += bl[2 * KD];
-      h_host += Hl.template block<KD, 1>(0, 2 * KD);
+      Hpp += Hgg(NG - 1, NG - 1);
+      bp += bg[NG - 1];
+      h_host += Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol);
       L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
       Eigen::Map<Eigen::Matrix<double, KD, 1>>(L.hpc.data() + static_cast<size_t>(ab + nb) * KD) =
-          Hl.template block<KD, 1>(KD, 2 * KD);
+          Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol + KD);
       ++nb;
-      cs.H.template block<KD, KD>(hb * KD, hb * KD) += Hl.template block<KD, KD>(0, 0);
-      cs.H.template block<KD, KD>(hb * KD, tb * KD) += Hl.template block<KD, KD>(0, KD);
-      cs.H.template block<KD, KD>(tb * KD, hb * KD) += Hl.template block<KD, KD>(KD, 0);
-      cs.H.template block<KD, KD>(tb * KD, tb * KD) += Hl.template block<KD, KD>(KD, KD);
-      cs.b.template segment<KD>(hb * KD) += bl.template head<KD>();
-      cs.b.template segment<KD>(tb * KD) += bl.template segment<KD>(KD);
     }
     L.Hpp[static_cast<size_t>(i)] = Hpp;
     L.bp[static_cast<size_t>(i)] = bp;
