@@ -57,8 +57,8 @@ KeyframeWindow::KeyframeWindow(const WindowSetup& setup, const CameraModel& came
     SmoothMotionOptions so;
     so.information = setup.smooth_motion_information;
     smooth_motion_ = std::make_unique<SmoothMotionTerm>(so);
-    ba_->setTerms({smooth_motion_.get()});
   }
+  updateTerms();
   prior_ = std::make_unique<MarginalizationPrior>(setup.ba.layout);
   min_act_dist_ = bo_.activation_min_dist_px;
 }
@@ -82,6 +82,19 @@ Keyframe& KeyframeWindow::insert(std::unique_ptr<Keyframe> kf) {
     if (h.get() != nk)
       for (ActivePoint& p : h->points) p.obs.push_back(ActiveObservation{nk});
   return *nk;
+}
+
+void KeyframeWindow::updateTerms() {
+  std::vector<const WindowTerm*> terms;
+  if (smooth_motion_) terms.push_back(smooth_motion_.get());
+  if (inertial_ && inertial_->term()) terms.push_back(inertial_->term());
+  ba_->setTerms(terms);
+}
+
+bool KeyframeWindow::initializeInertial(const std::vector<ViInitKeyframe>& keyframes) {
+  if (!inertial_ || !inertial_->tryInitialize(keyframes, window_, *ba_, *prior_)) return false;
+  updateTerms();
+  return true;
 }
 
 void KeyframeWindow::optimize(int max_iterations) { last_ba_ = ba_->optimize(window_, *prior_, max_iterations); }
@@ -356,6 +369,7 @@ void KeyframeWindow::marginalizeKeyframe(Keyframe* kf, WindowSink& sink) {
   kf->points.clear();
   kf->candidates.clear();
   marginalizeMotionTerms(kf);
+  if (inertial_) inertial_->marginalizeTerms(*kf, window_, *prior_);
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
   ba_->keyframePriorTerm(*kf, &H, &b);

@@ -20,7 +20,9 @@
 //   observation at its final linearisation, a marginalised point, a marginalised keyframe's final
 //   state. What the prior holds about a leaving keyframe or point is added before it is removed.
 // - A smooth-motion term is active only while its keyframe and its neighbours are in the window; a
-//   term touching a leaving keyframe goes into the prior first (marginalizeMotionTerms).
+//   term touching a leaving keyframe goes into the prior first (marginalizeMotionTerms). The same holds
+//   for the inertial terms of a visual-inertial run (inertial_state.h), which the window hands to the
+//   prior through the InertialState given by setInertial() before a keyframe's block is marginalised.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -37,6 +39,7 @@
 #include "rsvio/frontend/frontend_options.h"
 #include "rsvio/interfaces/camera.h"
 #include "rsvio/interfaces/solver.h"
+#include "inertial_state.h"
 
 namespace rsvio {
 
@@ -111,7 +114,15 @@ class KeyframeWindow {
 
   const BundleAdjustmentStats& lastStats() const { return last_ba_; }
 
+  // Visual-inertial runs: the inertial part whose terms leave with the keyframes (may be null).
+  void setInertial(InertialState* inertial) { inertial_ = inertial; }
+  // Tries the visual-inertial initialisation on the run's keyframe poses (InertialState::tryInitialize);
+  // on success the bundle adjuster's terms gain the inertial term. Returns true when it succeeded now.
+  bool initializeInertial(const std::vector<ViInitKeyframe>& keyframes);
+  KeyframeList& mutableKeyframes() { return window_; }
+
  private:
+  void updateTerms();
   void linkMotionNeighbours(Keyframe& kf);
   void marginalizeMotionTerms(const Keyframe* leaving);
   double medianIdepth() const;
@@ -126,6 +137,7 @@ class KeyframeWindow {
   std::unique_ptr<BundleAdjuster> ba_;
   std::unique_ptr<SmoothMotionTerm> smooth_motion_;  // rolling shutter with a smooth-motion prior, else null
   std::unique_ptr<MarginalizationPrior> prior_;
+  InertialState* inertial_ = nullptr;
   KeyframeList window_;
   int64_t next_kf_id_ = 0;
   int64_t next_point_id_ = 0;

@@ -7,7 +7,7 @@
 //                                          stage times, warnings: what the outputs are written from
 //   (c) Tracking        tracking.h         frame tracker and its reference, motion history, guesses
 //   (d) MonoStart       mono_start.h       the monocular initialiser and its frames
-//   (e) InertialState  inertial_state.h   (not composed yet) IMU buffer, per-keyframe velocity and
+//   (e) InertialState   inertial_state.h   visual-inertial runs only: IMU buffer, per-keyframe velocity and
 //                                          biases, T_Wm_Wf (scale and gravity), time offset, IMU
 //                                          factors and twist energy; fed by addImu(), its terms reach
 //                                          the window's optimisation as a WindowTerm
@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "inertial_state.h"
 #include "keyframe_window.h"
 #include "mono_start.h"
 #include "rsvio/backend/backend_options.h"
@@ -61,11 +62,12 @@ struct Odometry::Impl {
   std::unique_ptr<Tracking> tracking;      // (c)
   std::unique_ptr<KeyframeWindow> window;  // (a)
   std::unique_ptr<MonoStart> start;        // (d)
-  // (e) std::unique_ptr<InertialState> inertial; joins here (inertial_state.h).
+  std::unique_ptr<InertialState> inertial; // (e) null for visual odometry
   // Run status.
   bool initialized = false;
   bool failed = false;
   std::string failure;
+  int64_t vi_init_t_ns = -1;  // the keyframe time of the visual-inertial initialisation
 
   Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSetup& s);
 
@@ -74,6 +76,10 @@ struct Odometry::Impl {
   void makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms, std::shared_ptr<const ImagePyramid> pyr,
                     const SE3d& T_c_w, const AffineBrightness& affine);
   void checkDivergence();
+  void tryInertialInitialisation();
+  void fillInertial(int64_t t_ns);   // the history entry of t_ns gets its inertial fields (VIO)
+  io::Trajectory toBody(io::Trajectory t) const;
+  void toMetric(MapPoint* p) const;               // W_f -> W_m (VIO, after the initialisation)  // camera poses in W_f -> body poses in W_m (VIO)
   void finish();
   void fail(const std::string& reason);
 };

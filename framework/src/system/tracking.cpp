@@ -65,6 +65,12 @@ void Tracking::pushHistory(int64_t t_ns, const SE3d& T_c_w, bool is_keyframe) {
   if (history_.size() > kHistory) history_.erase(history_.begin(), history_.begin() + (history_.size() - kHistory));
 }
 
+MotionState* Tracking::historyAt(int64_t t_ns) {
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it)
+    if (it->t_ns == t_ns) return &*it;
+  return nullptr;
+}
+
 void Tracking::keyframeOptimised(int64_t t_ns, const SE3d& T_c_w) {
   for (MotionState& s : history_)
     if (s.t_ns == t_ns) {

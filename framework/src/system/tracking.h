@@ -45,6 +45,8 @@ class Tracking {
   // Motion history.
   void pushHistory(int64_t t_ns, const SE3d& T_c_w, bool is_keyframe);
   void keyframeOptimised(int64_t t_ns, const SE3d& T_c_w);  // the keyframe's entry takes its optimised pose
+  // The history entry of time t_ns (null: none), e.g. for the inertial state to fill its VIO fields.
+  MotionState* historyAt(int64_t t_ns);
   std::vector<SE3d> guesses(int64_t t_ns) const;             // every motion prior's, else the last pose
   Vec6 velocityEstimate() const;  // per second, from the last two tracked frames (0 without)
   // Rolling shutter: a new frame's twist (see tracking.cpp); newest: the newest keyframe, or nullptr.
