@@ -5,6 +5,8 @@
 # on both and reports peak RSS (getrusage ru_maxrss of the run process) and the size of every output
 # file, so what grows with the sequence shows (the diagnostics log and per-frame records are expected
 # to). Usage: scripts/bench_memory.sh [build-dir] [work-dir]   (defaults: build, /tmp/rsvio_bench_memory)
+# TAG=name names the runs (run_<name>_<dur>s), so two builds can be compared on the same simulated data.
+# Figures: docs/backend.md, "Memory on long runs".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -12,6 +14,7 @@ BUILD=${1:-build}
 WORK=${2:-/tmp/rsvio_bench_memory}
 SHORT_S=${SHORT_S:-60}
 LONG_S=${LONG_S:-600}
+TAG=${TAG:+${TAG}_}
 BIN="$BUILD/bin/rsvio"
 [ -x "$BIN" ] || { echo "rsvio: $BIN not found (build first: bash scripts/build.sh)" >&2; exit 2; }
 mkdir -p "$WORK"
@@ -31,15 +34,15 @@ for dur in "$SHORT_S" "$LONG_S"; do
       --set motion.mean_accel_m_s2=1.1 --set motion.mean_rot_accel_deg_s2=130
   fi
   echo "running gs_vo on ${dur} s ..."
-  read -r kb rc < <(peak_kb "$BIN" -q run --config "$ROOT/configs/gs_vo.json" --data "$data" --out "$WORK/run_${dur}s" \
+  read -r kb rc < <(peak_kb "$BIN" -q run --config "$ROOT/configs/gs_vo.json" --data "$data" --out "$WORK/run_${TAG}${dur}s" \
                       --set output.render=false)
-  echo "$dur $kb $rc" > "$WORK/peak_${dur}s.txt"
+  echo "$dur $kb $rc" > "$WORK/peak_${TAG}${dur}s.txt"
 done
 echo
 echo "sequence  frames  status  peak RSS (MB)  outputs (kB): trajectory keyframes states points diagnostics"
 for dur in "$SHORT_S" "$LONG_S"; do
-  read -r d kb rc < "$WORK/peak_${dur}s.txt"
-  run="$WORK/run_${dur}s"
+  read -r d kb rc < "$WORK/peak_${TAG}${dur}s.txt"
+  run="$WORK/run_${TAG}${dur}s"
   frames=$(python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); print(r["frames"], r["status"])' "$run/report.json")
   sizes=""
   for f in trajectory.tum keyframes.tum states.csv points.ply diagnostics.bin; do
@@ -47,6 +50,6 @@ for dur in "$SHORT_S" "$LONG_S"; do
   done
   printf "%6s s  %s  %13.1f  %s\n" "$dur" "$frames" "$(python3 -c "print($kb / 1024)")" "$sizes"
 done
-read -r _ kb_s _ < "$WORK/peak_${SHORT_S}s.txt"
-read -r _ kb_l _ < "$WORK/peak_${LONG_S}s.txt"
+read -r _ kb_s _ < "$WORK/peak_${TAG}${SHORT_S}s.txt"
+read -r _ kb_l _ < "$WORK/peak_${TAG}${LONG_S}s.txt"
 python3 -c 'import sys; s, l = float(sys.argv[1]), float(sys.argv[2]); print("peak RSS long/short: %.3f (goal <= 1.10)" % (l / s))' "$kb_s" "$kb_l"

@@ -1,5 +1,7 @@
 #include "rsvio/io/diagnostics_log.h"
 
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 
@@ -23,11 +25,10 @@ struct Header {
   uint64_t n_obs;
   uint64_t n_imu;
 };
-}  // namespace
 
-void DiagnosticsLog::write(const std::string& path) const {
-  io::writeFileAtomic(path, [&](std::ostream& out) {
-  Header h{};
+// Filled in place with its padding zeroed, so the file's bytes are deterministic.
+void fillHeader(Header& h, int width, int height, double line_delay_s, uint64_t n_obs, uint64_t n_imu) {
+  std::memset(&h, 0, sizeof(h));
   std::memcpy(h.magic, kMagic, 8);
   h.version = kVersion;
   h.obs_size = sizeof(ObservationRow);
@@ -35,13 +36,78 @@ void DiagnosticsLog::write(const std::string& path) const {
   h.width = width;
   h.height = height;
   h.line_delay_s = line_delay_s;
-  h.n_obs = observations.size();
-  h.n_imu = imu.size();
-  out.write(reinterpret_cast<const char*>(&h), sizeof(h));
-  out.write(reinterpret_cast<const char*>(observations.data()),
-            static_cast<std::streamsize>(observations.size() * sizeof(ObservationRow)));
-  out.write(reinterpret_cast<const char*>(imu.data()), static_cast<std::streamsize>(imu.size() * sizeof(ImuRow)));
-  }, "diagnostics log", /*binary=*/true);
+  h.n_obs = n_obs;
+  h.n_imu = n_imu;
+}
+}  // namespace
+
+void DiagnosticsLog::write(const std::string& path) const {
+  DiagnosticsWriter w(path, width, height, line_delay_s);
+  w.append(observations);
+  w.close(imu);
+}
+
+DiagnosticsWriter::DiagnosticsWriter(const std::string& path, int width, int height, double line_delay_s)
+    : path_(path), tmp_(io::atomicTempPath(path)), width_(width), height_(height), line_delay_s_(line_delay_s) {
+  out_ = std::make_unique<std::ofstream>(tmp_, std::ios::binary | std::ios::trunc);
+  if (!*out_) {
+    const std::string why = std::strerror(errno);
+    out_.reset();
+    throw Error(path_ + ": cannot write diagnostics log (" + why + ")");
+  }
+  Header h;
+  fillHeader(h, width_, height_, line_delay_s_, 0, 0);  // the counts: written by close()
+  out_->write(reinterpret_cast<const char*>(&h), sizeof(h));
+  if (!*out_) {
+    abandon();
+    throw Error(path_ + ": write failed (diagnostics log)");
+  }
+}
+
+DiagnosticsWriter::~DiagnosticsWriter() { abandon(); }
+
+void DiagnosticsWriter::abandon() {
+  if (!out_) return;
+  out_->close();
+  out_.reset();
+  std::remove(tmp_.c_str());
+}
+
+void DiagnosticsWriter::append(const ObservationRow* rows, size_t n) {
+  if (!out_) throw Error(path_ + ": diagnostics log already closed");
+  if (n == 0) return;
+  out_->write(reinterpret_cast<const char*>(rows), static_cast<std::streamsize>(n * sizeof(ObservationRow)));
+  if (!*out_) {
+    abandon();
+    throw Error(path_ + ": write failed (diagnostics log)");
+  }
+  n_obs_ += n;
+}
+
+void DiagnosticsWriter::close(const std::vector<ImuRow>& imu) {
+  if (!out_) throw Error(path_ + ": diagnostics log already closed");
+  out_->write(reinterpret_cast<const char*>(imu.data()), static_cast<std::streamsize>(imu.size() * sizeof(ImuRow)));
+  Header h;
+  fillHeader(h, width_, height_, line_delay_s_, n_obs_, imu.size());
+  out_->seekp(0);
+  out_->write(reinterpret_cast<const char*>(&h), sizeof(h));
+  out_->flush();
+  if (!*out_) {
+    abandon();
+    throw Error(path_ + ": write failed (diagnostics log)");
+  }
+  out_->close();
+  const bool closed = static_cast<bool>(*out_);
+  out_.reset();
+  if (!closed) {
+    std::remove(tmp_.c_str());
+    throw Error(path_ + ": write failed (diagnostics log)");
+  }
+  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(tmp_.c_str());
+    throw Error(path_ + ": cannot write diagnostics log (rename: " + why + ")");
+  }
 }
 
 DiagnosticsLog DiagnosticsLog::read(const std::string& path) {

@@ -2,7 +2,9 @@
 #include "rsvio/io/ply.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -64,6 +66,17 @@ double readBinaryScalar(const char* p, const std::string& t) {
   return v;
 }
 
+void writeHeader(std::ostream& f, size_t n) {
+  f << "ply\nformat ascii 1.0\ncomment rsvio sparse point cloud, world frame\n"
+    << "element vertex " << n << "\n"
+    << "property float x\nproperty float y\nproperty float z\nproperty float intensity\nend_header\n";
+}
+
+// One vertex line; the stream's precision is 9 significant digits.
+void writeVertex(std::ostream& f, const Eigen::Vector3d& p, float intensity) {
+  f << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << intensity << '\n';
+}
+
 int findProp(const PlyElement& e, const char* name) {
   for (size_t i = 0; i < e.props.size(); ++i) {
     if (e.props[i].name == name) return static_cast<int>(i);
@@ -79,15 +92,63 @@ void writePly(const std::string& path, const PointCloud& cloud) {
                 std::to_string(cloud.intensity.size()) + " intensities");
   }
   writeFileAtomic(path, [&](std::ostream& f) {
-  f << "ply\nformat ascii 1.0\ncomment rsvio sparse point cloud, world frame\n"
-    << "element vertex " << cloud.size() << "\n"
-    << "property float x\nproperty float y\nproperty float z\nproperty float intensity\nend_header\n";
+  writeHeader(f, cloud.size());
   f << std::setprecision(9);
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const auto& p = cloud.p_W[i];
-    f << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << cloud.intensity[i] << '\n';
-  }
+  for (size_t i = 0; i < cloud.size(); ++i) writeVertex(f, cloud.p_W[i], cloud.intensity[i]);
   }, "point cloud");
+}
+
+PlyStreamWriter::PlyStreamWriter(const std::string& path) : path_(path), body_(atomicTempPath(path) + ".body") {
+  out_ = std::make_unique<std::ofstream>(body_, std::ios::trunc);
+  if (!*out_) {
+    const std::string why = std::strerror(errno);
+    out_.reset();
+    throw Error(path_ + ": cannot write point cloud (" + why + ")");
+  }
+  *out_ << std::setprecision(9);
+}
+
+PlyStreamWriter::~PlyStreamWriter() { abandon(); }
+
+void PlyStreamWriter::abandon() {
+  if (!out_) return;
+  out_->close();
+  out_.reset();
+  std::remove(body_.c_str());
+}
+
+void PlyStreamWriter::append(const Eigen::Vector3d& p_W, float intensity) {
+  if (!out_) throw Error(path_ + ": point cloud already closed");
+  writeVertex(*out_, p_W, intensity);
+  if (!*out_) {
+    abandon();
+    throw Error(path_ + ": write failed (point cloud)");
+  }
+  ++n_;
+}
+
+void PlyStreamWriter::close() {
+  if (!out_) throw Error(path_ + ": point cloud already closed");
+  out_->close();
+  const bool ok = static_cast<bool>(*out_);
+  out_.reset();
+  if (!ok) {
+    std::remove(body_.c_str());
+    throw Error(path_ + ": write failed (point cloud)");
+  }
+  try {
+    writeFileAtomic(path_, [&](std::ostream& f) {
+      writeHeader(f, n_);
+      std::ifstream in(body_);
+      if (!in) throw Error(path_ + ": cannot read back the point cloud's temporary " + body_);
+      if (n_ > 0) f << in.rdbuf();  // streamed copy, bounded buffer
+      if (!f) throw Error(path_ + ": write failed (point cloud)");
+    }, "point cloud");
+  } catch (...) {
+    std::remove(body_.c_str());
+    throw;
+  }
+  std::remove(body_.c_str());
 }
 
 PointCloud readPly(const std::string& path) {

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <memory>
 
 #include "rsvio/config/config.h"
 #include "rsvio/config/validate.h"
@@ -19,6 +20,7 @@
 #include "rsvio/eval/eval_output.h"
 #include "rsvio/eval/evaluate_files.h"
 #include "rsvio/interfaces/data_source.h"
+#include "rsvio/io/diagnostics_log.h"
 #include "rsvio/io/ply.h"
 #include "rsvio/io/trajectory.h"
 #include "rsvio/plugin/host.h"
@@ -67,8 +69,79 @@ double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// diagnostics.bin and points.ply are written while the run goes (issue 16: a long run's memory stays
+// flat): the diagnostics rows and the points that left the window are taken from the estimator after
+// every frame and appended to the files' temporaries (DiagnosticsWriter, PlyStreamWriter), which
+// close() completes and renames with the other outputs, so the final names appear only complete.
+// Without output.diagnostics / output.points they are taken and dropped. An I/O error becomes a
+// warning and that file is not written (as for every output).
+class OutputStreams {
+ public:
+  OutputStreams(Odometry& odo, const std::string& out, const nlohmann::json& cfg, std::vector<std::string>& warnings)
+      : odo_(odo), warnings_(warnings) {
+    if (cfg.at("output").at("diagnostics").get<bool>()) {
+      const DiagnosticsLog& d = odo.diagnostics();
+      guarded("diagnostics.bin", [&] {
+        diag_ = std::make_unique<DiagnosticsWriter>((fs::path(out) / "diagnostics.bin").string(), d.width, d.height,
+                                                    d.line_delay_s);
+      });
+    }
+    if (cfg.at("output").at("points").get<bool>())
+      guarded("points.ply",
+              [&] { ply_ = std::make_unique<io::PlyStreamWriter>((fs::path(out) / "points.ply").string()); });
+  }
+  // What the estimator made since the last call goes to the files (or is dropped). The buffers keep
+  // their capacity: bounded by what one frame makes.
+  void take() {
+    odo_.takeDiagnostics(&rows_);
+    if (diag_ && !rows_.empty() && !guarded("diagnostics.bin", [&] { diag_->append(rows_); })) diag_.reset();
+    rows_.clear();
+    odo_.takePoints(&points_);
+    if (ply_ && !points_.empty() && !guarded("points.ply", [&] { appendPoints(points_); })) ply_.reset();
+    points_.clear();
+  }
+  // points.ply complete: the points taken, then those still in the estimator (its window's).
+  void closePoints() {
+    take();
+    if (!ply_) return;
+    guarded("points.ply", [&] {
+      appendPoints(odo_.points());
+      ply_->close();
+    });
+    ply_.reset();
+  }
+  // diagnostics.bin complete: the rows taken, then the IMU rows.
+  void closeDiagnostics() {
+    take();
+    if (!diag_) return;
+    guarded("diagnostics.bin", [&] { diag_->close(odo_.diagnostics().imu); });
+    diag_.reset();
+  }
+
+ private:
+  bool guarded(const char* what, const std::function<void()>& f) {
+    try {
+      f();
+      return true;
+    } catch (const std::exception& e) {
+      warnings_.push_back(std::string("could not write ") + what + ": " + e.what());
+      return false;
+    }
+  }
+  void appendPoints(const std::vector<MapPoint>& points) {
+    for (const MapPoint& p : points) ply_->append(p.p_w.cast<double>(), p.intensity);
+  }
+
+  Odometry& odo_;
+  std::vector<std::string>& warnings_;
+  std::unique_ptr<DiagnosticsWriter> diag_;
+  std::unique_ptr<io::PlyStreamWriter> ply_;
+  std::vector<ObservationRow> rows_;
+  std::vector<MapPoint> points_;
+};
+
 // Writes everything the odometry has, even after a failure. Returns problems as warnings.
-void writeOutputs(const Odometry& odo, const std::string& out, const nlohmann::json& cfg,
+void writeOutputs(const Odometry& odo, const std::string& out, OutputStreams& streams,
                   std::vector<std::string>& warnings) {
   auto guarded = [&](const char* what, const std::function<void()>& f) {
     try {
@@ -81,18 +154,8 @@ void writeOutputs(const Odometry& odo, const std::string& out, const nlohmann::j
   guarded("keyframes.tum",
           [&] { io::writeTum((fs::path(out) / "keyframes.tum").string(), odo.keyframeTrajectory()); });
   guarded("states.csv", [&] { writeStates(odo.states(), (fs::path(out) / "states.csv").string()); });
-  if (cfg.at("output").at("points").get<bool>()) {
-    guarded("points.ply", [&] {
-      io::PointCloud cloud;
-      for (const auto& p : odo.points()) {
-        cloud.p_W.push_back(p.p_w.cast<double>());
-        cloud.intensity.push_back(p.intensity);
-      }
-      io::writePly((fs::path(out) / "points.ply").string(), cloud);
-    });
-  }
-  if (cfg.at("output").at("diagnostics").get<bool>())
-    guarded("diagnostics.bin", [&] { odo.diagnostics().write((fs::path(out) / "diagnostics.bin").string()); });
+  streams.closePoints();       // with output.points: points.ply, written during the run, now complete
+  streams.closeDiagnostics();  // with output.diagnostics: diagnostics.bin likewise
 }
 
 // ATE on keyframes (conventions.md: report.json's ATE is on keyframes, paper eq. 35).
@@ -176,6 +239,7 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
 
   const auto t_start = Clock::now();
   Odometry odo(cfg, host, sensors);
+  OutputStreams streams(odo, request.out_dir, cfg, report.warnings);
   const auto& imu = source->imu();
   size_t imu_next = 0;
   const size_t n = source->numFrames();
@@ -211,6 +275,7 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
       break;
     }
     ++processed;
+    streams.take();
     const bool print_now = request.verbosity >= 2 || (request.verbosity >= 1 && secondsSince(last_print) > 2.0);
     if (print_now || (request.verbosity >= 1 && i + 1 == n)) {
       const double el = secondsSince(t_start);
@@ -248,7 +313,7 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   if (odo.usesImu()) report.scale = odo.scale();
   for (const auto& w : odo.warnings()) report.warnings.push_back(w);
 
-  writeOutputs(odo, request.out_dir, cfg, report.warnings);
+  writeOutputs(odo, request.out_dir, streams, report.warnings);
   // A failed run is evaluated too: what it estimated before the failure is worth a figure.
   if (cfg["output"]["evaluate"].get<bool>()) evaluate(request.data_dir, request.out_dir, report);
   report.write((fs::path(request.out_dir) / "report.json").string());

@@ -394,6 +394,8 @@ bool Odometry::usesImu() const { return false; }
 double Odometry::scale() const { return 1.0; }
 std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }
 const DiagnosticsLog& Odometry::diagnostics() const { return impl_->record->diagnostics(); }
+void Odometry::takeDiagnostics(std::vector<ObservationRow>* rows) { impl_->record->takeObservations(rows); }
+void Odometry::takePoints(std::vector<MapPoint>* points) { impl_->record->takePoints(points); }
 
 io::Trajectory Odometry::frameTrajectory() const { return impl_->record->frameTrajectory(impl_->window->keyframes()); }
 io::Trajectory Odometry::keyframeTrajectory() const {

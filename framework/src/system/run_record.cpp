@@ -36,6 +36,24 @@ FrameRecord* RunRecord::frame(int64_t index) {
   return nullptr;
 }
 
+void RunRecord::takeObservations(std::vector<ObservationRow>* rows) {
+  if (rows->empty()) {
+    rows->swap(diag_.observations);  // the two buffers trade places: no copy, capacities kept
+  } else {
+    rows->insert(rows->end(), diag_.observations.begin(), diag_.observations.end());
+  }
+  diag_.observations.clear();
+}
+
+void RunRecord::takePoints(std::vector<MapPoint>* points) {
+  if (points->empty()) {
+    points->swap(map_points_);
+  } else {
+    points->insert(points->end(), map_points_.begin(), map_points_.end());
+  }
+  map_points_.clear();
+}
+
 void RunRecord::recordFinal(Keyframe& kf) {
   observedTwist(kf);
   recordKeyframe(kf);

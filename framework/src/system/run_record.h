@@ -7,8 +7,9 @@
 //   tracked against and its pose relative to it;
 // - one KeyframeRecord per keyframe of the run, by kf_id: the state it was last recorded with (for a
 //   marginalised keyframe its final one);
-// - the map points that left the window, the diagnostics log (one row per inlier observation when it
-//   leaves the window, io/diagnostics_log.h), the stage times and the run's warnings.
+// - the map points that left the window (those not yet taken out), the diagnostics log (one row per inlier observation when it
+//   leaves the window, io/diagnostics_log.h; only those made since the last takeObservations() when a
+//   run loop streams them out), the stage times and the run's warnings.
 //
 // Invariants
 // - Frame indices are unique (sequence positions). Records are only appended, except that a frame's
@@ -84,6 +85,10 @@ class RunRecord : public WindowSink {
   void addWarning(const std::string& w) { warnings_.push_back(w); }
   const std::vector<std::string>& warnings() const { return warnings_; }
   const DiagnosticsLog& diagnostics() const { return diag_; }
+  // Moves the observation rows out (appended to *rows); the log keeps its header fields and IMU rows.
+  void takeObservations(std::vector<ObservationRow>* rows);
+  // Moves the map points that left the window out (appended to *points).
+  void takePoints(std::vector<MapPoint>* points);
 
   // Outputs, with the keyframes and points still in `window` at their current state.
   io::Trajectory frameTrajectory(const KeyframeList& window) const;     // refined frame poses

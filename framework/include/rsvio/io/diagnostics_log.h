@@ -17,7 +17,10 @@
 // uint64 n_obs, uint64 n_imu, then the rows, little-endian as on x86-64 / aarch64.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <iosfwd>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -55,8 +58,40 @@ struct DiagnosticsLog {
   std::vector<ObservationRow> observations;
   std::vector<ImuRow> imu;
 
-  void write(const std::string& path) const;               // throws Error on I/O failure
+  void write(const std::string& path) const;               // throws Error on I/O failure (DiagnosticsWriter)
   static DiagnosticsLog read(const std::string& path);     // throws DataError on a bad file
+};
+
+// Writes a diagnostics log while it is made, so a long run need not hold its rows (issue 16): the
+// observation rows go to the atomic temporary of `path` (io/atomic_file.h, "<path>.tmp-<pid>") as they
+// are appended; close() adds the IMU rows and the header's row counts, then renames the temporary to
+// `path`. The file is the one DiagnosticsLog::write gives for the same rows, byte for byte.
+// - Until close() succeeds, `path` is not touched: a process killed at any moment leaves at most the
+//   temporary (rsvio run removes such temporaries of an earlier run), never a truncated `path`.
+// - Destroyed without close(), or after an I/O error, the temporary is removed.
+// - Memory: the stream's buffer only (rows are not kept).
+class DiagnosticsWriter {
+ public:
+  // Throws Error when the temporary cannot be created.
+  DiagnosticsWriter(const std::string& path, int width, int height, double line_delay_s);
+  ~DiagnosticsWriter();
+  DiagnosticsWriter(const DiagnosticsWriter&) = delete;
+  DiagnosticsWriter& operator=(const DiagnosticsWriter&) = delete;
+
+  void append(const ObservationRow* rows, size_t n);  // throws Error on I/O failure
+  void append(const std::vector<ObservationRow>& rows) { append(rows.data(), rows.size()); }
+  // The IMU rows, the counts, then the rename; throws Error on I/O failure. Once only.
+  void close(const std::vector<ImuRow>& imu);
+  uint64_t numObservations() const { return n_obs_; }
+
+ private:
+  void abandon();  // closes and removes the temporary
+  std::string path_;
+  std::string tmp_;
+  int width_ = 0, height_ = 0;
+  double line_delay_s_ = 0.0;
+  uint64_t n_obs_ = 0;
+  std::unique_ptr<std::ofstream> out_;  // open until close() or abandon()
 };
 
 }  // namespace rsvio

@@ -58,9 +58,16 @@ class Odometry {
   // Results (valid any time; complete after finish()).
   io::Trajectory frameTrajectory() const;     // every tracked frame, refined (conventions.md, Outputs)
   io::Trajectory keyframeTrajectory() const;  // keyframes after their last optimisation
-  std::vector<MapPoint> points() const;
+  std::vector<MapPoint> points() const;  // those not taken by takePoints(), then the window's
+  // Appends the points that left the window so far to *points and forgets them (as takeDiagnostics).
+  void takePoints(std::vector<MapPoint>* points);
   std::vector<StateRow> states() const;
-  const DiagnosticsLog& diagnostics() const;  // a reference: the log grows with the run (no copy to write it)
+  // The diagnostics log: image size, line delay, IMU rows, and the observation rows made since the last
+  // takeDiagnostics() (every row of the run when it is never called).
+  const DiagnosticsLog& diagnostics() const;
+  // Appends the observation rows made so far to *rows and forgets them: the run loop streams them to
+  // diagnostics.bin as the run goes (pipeline/run.cpp), so a long run's memory stays flat.
+  void takeDiagnostics(std::vector<ObservationRow>* rows);
   std::map<std::string, double> stageMs() const;  // mean ms per call of each stage
   long numKeyframes() const;
   bool usesImu() const;
