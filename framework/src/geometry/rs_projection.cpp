@@ -141,7 +141,9 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
                            const Eigen::VectorXd& idepth, std::vector<RsHostProjection>& out,
                            const RsProjectionOptions& options) {
   const Eigen::Index n = bearing_h.cols();
-  out.assign(static_cast<size_t>(n), RsHostProjection());
+  // Every entry is reset below: the world-point fields by solveWorldPoints(), the host fields here
+  // (one zero-fill per entry instead of two).
+  out.resize(static_cast<size_t>(n));
   const SE3d T_w_h0 = host.T_c_w0.inverse();
   const Eigen::Matrix3d R_w_h0 = T_w_h0.rotationMatrix();
   const Vec3 xh_v = host.xi.head<3>(), xh_w = host.xi.tail<3>();
@@ -153,8 +155,15 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
   Eigen::Matrix3Xd X(3, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const double rho = idepth[i];
-    if (!(rho > 0.0) || !std::isfinite(rho)) continue;
+    if (!(rho > 0.0) || !std::isfinite(rho)) {
+      out[static_cast<size_t>(i)] = RsHostProjection();
+      continue;
+    }
     const size_t s = static_cast<size_t>(i);
+    RsHostProjection& o = out[s];
+    o.d_uv_d_Th0.setZero();
+    o.d_uv_d_xi_h.setZero();
+    o.d_uv_d_idepth.setZero();
     Eh_inv[s] = expOrIdentity(-host.xi * timing.rowTime(v_h[i]));
     Z[s] = Eh_inv[s] * Vec3(bearing_h.col(i) / rho);
     X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * Z[s];
