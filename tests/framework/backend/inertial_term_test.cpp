@@ -14,7 +14,9 @@
 #include "rsvio/imu/preintegration.h"
 #include "rsvio/imu/twist_prior.h"
 #include "rsvio/imu/visual_inertial_factor.h"
+#include "rsvio/interfaces/solver.h"
 #include "support/numeric_jacobian.h"
+#include "support/plugin_contracts.h"
 
 namespace rsvio {
 namespace {
@@ -278,6 +280,58 @@ TEST(InertialTerm, PriorSetLayoutKeepsTheVisualInformation) {
   EXPECT_JACOBIAN_NEAR(prior.H().block(vi.stateDim(), vi.stateDim(), 14, 14), Ht.block(14, 14, 14, 14), 1e-12);
   EXPECT_EQ(prior.H().block(14, 0, 9, prior.H().cols()).cwiseAbs().maxCoeff(), 0.0);
 }
+
+}  // namespace
+}  // namespace rsvio
+
+namespace rsvio {
+namespace {
+
+// With the inertial blocks the reduced camera system (Schur complement of the points) and the full
+// system still give the same step, for a global and a rolling shutter: the points couple only to the
+// photometric blocks, the inertial and global blocks only through the window terms.
+void checkSchurAgainstFull(bool rolling) {
+  test::TestWindow w(3, rolling, rolling ? 5e-5 : 0.0);
+  w.addPoints(0, 200);
+  w.addPoints(1, 150, 4);
+  w.window[0]->gauge = true;
+  InertialChain c(rolling, true);
+  for (size_t k = 0; k < 3; ++k) {  // the chain's inertial states and factors on the rendered keyframes
+    Keyframe& kf = *w.window[k];
+    kf.t_ns = c.window[k]->t_ns;
+    kf.state.v_wm = c.window[k]->state.v_wm;
+    kf.state.bias_gyro = c.window[k]->state.bias_gyro;
+    kf.state.bias_accel = c.window[k]->state.bias_accel;
+    kf.gyro_at_t = c.window[k]->gyro_at_t;
+    kf.twist_energy = rolling;
+    if (k > 0) {
+      kf.imu_term = true;
+      kf.imu_prev = w.window[k - 1].get();
+      kf.imu_factor = c.factors[k - 1];
+    }
+  }
+  auto solver = test::makePlugin<SolverBackend>("solver.dense");
+  BundleAdjustmentConfig cfg;
+  cfg.layout = c.layout;
+  BundleAdjuster ba(cfg, w.camera, w.timing, *solver);
+  ba.setGlobals(&c.globals);
+  const InertialTerm term(InertialTermOptions{}, c.T_cm_i, &c.globals);
+  ba.setTerms({&term});
+  MarginalizationPrior prior(cfg.layout);
+  ba.linearize(w.window, prior);
+  for (double lambda : {1e-4, 1e-2, 0.5}) {
+    Eigen::VectorXd c1, p1, c2, p2;
+    ASSERT_TRUE(ba.solveStep(lambda, false, &c1, &p1));
+    ASSERT_TRUE(ba.solveStep(lambda, true, &c2, &p2));
+    ASSERT_EQ(c1.size(), cfg.layout.windowDim(3));
+    EXPECT_LT((c1 - c2).norm(), 1e-6 * (1.0 + c1.norm())) << "lambda " << lambda << "\n" << c1.transpose() << "\n" << c2.transpose();
+    EXPECT_LT((p1 - p2).norm(), 1e-6 * (1.0 + p1.norm())) << "lambda " << lambda;
+    EXPECT_GT(c1.tail(cfg.layout.globalDim()).norm(), 0.0);
+  }
+}
+
+TEST(InertialTerm, SchurAndFullSystemGiveTheSameStepGlobalShutter) { checkSchurAgainstFull(false); }
+TEST(InertialTerm, SchurAndFullSystemGiveTheSameStepRollingShutter) { checkSchurAgainstFull(true); }
 
 }  // namespace
 }  // namespace rsvio
