@@ -311,6 +311,13 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   report.realtime_factor = report.fps / rate;
   report.stage_ms = odo.stageMs();
   if (odo.usesImu()) report.scale = odo.scale();
+  if (const nlohmann::json vio = odo.inertialReport(); !vio.is_null()) {
+    report.extra["vio"] = vio;
+    if (!odo.usesImu())
+      report.warnings.push_back("the visual-inertial initialisation did not succeed (" +
+                                vio["status"].get<std::string>() + "): the outputs are visual odometry, "
+                                "camera poses without metric scale");
+  }
   for (const auto& w : odo.warnings()) report.warnings.push_back(w);
 
   writeOutputs(odo, request.out_dir, streams, report.warnings);

@@ -11,6 +11,7 @@
 #include "rsvio/config/validate.h"
 #include "rsvio/core/error.h"
 #include "rsvio/core/time.h"
+#include "rsvio/imu/inertial_options.h"
 #include "rsvio/plugin/host.h"
 
 namespace rsvio {
@@ -99,8 +100,55 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   tracking = std::make_unique<Tracking>(to, *camera, timing, motion_ptrs);
   window = std::make_unique<KeyframeWindow>(ws, *camera, timing, *solver);
   start = std::make_unique<MonoStart>(bo, *camera);
-  if (sensors.has_imu)
+  const InertialOptions io = inertialOptionsFromConfig(cfg);
+  if (io.enabled) {
+    if (!sensors.has_imu)
+      throw ConfigError("imu.enabled: the dataset " + sensors.dataset_dir +
+                        " has no IMU (imu0/data.csv); use a visual-odometry config (gs_vo, rs_vo) or "
+                        "--set imu.enabled=false");
+    double sigma_t = 0.0, sigma_r = 0.0;  // the IMU twist energy's Sigma, from the motion prior that has one
+    for (const auto& m : motion)
+      if (m->twistEnergySigma(&sigma_t, &sigma_r)) break;
+    inertial = std::make_unique<InertialState>(io, sensors, rolling, sigma_t, sigma_r);
+    window->setInertial(inertial.get());
+  } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
+  }
+}
+
+// Visual-inertial: the initialisation at each new keyframe until it succeeds, on the keyframe poses of
+// the run so far (the last 30 keyframes; marginalised ones at their final state).
+void Odometry::Impl::tryInertialInitialisation() {
+  if (!inertial || inertial->initialised() || window->size() < 2) return;
+  std::map<int64_t, SE3d> by_time;
+  for (const auto& [id, r] : record->keyframeRecords()) by_time[r.t_ns] = r.state.T_c_w;
+  for (const auto& k : window->keyframes()) by_time[k->t_ns] = k->state.T_c_w;
+  std::vector<ViInitKeyframe> kfs;
+  for (const auto& [t, T] : by_time) kfs.push_back(ViInitKeyframe{t, T});
+  constexpr size_t kMaxInitKeyframes = 30;
+  if (kfs.size() > kMaxInitKeyframes) kfs.erase(kfs.begin(), kfs.end() - kMaxInitKeyframes);
+  if (window->initializeInertial(kfs)) vi_init_t_ns = window->newest().t_ns;
+}
+
+void Odometry::Impl::fillInertial(int64_t t_ns) {
+  if (!inertial || !inertial->initialised() || window->empty()) return;
+  if (MotionState* ms = tracking->historyAt(t_ns)) inertial->fillMotionState(window->newest(), ms);
+}
+
+void Odometry::Impl::toMetric(MapPoint* p) const {
+  p->p_w = (inertial->globals().state.T_wm_wf * p->p_w.cast<double>()).cast<float>();
+}
+
+io::Trajectory Odometry::Impl::toBody(io::Trajectory t) const {
+  if (!inertial || !inertial->initialised()) return t;
+  t.frame = io::PoseFrame::kBody;
+  for (io::StampedPose& p : t.poses) {
+    const SE3d T_c_w = SE3d(p.q_W_X, p.p_W_X).inverse();
+    const SE3d T_wm_b = inertial->bodyPose(T_c_w);
+    p.p_W_X = T_wm_b.translation();
+    p.q_W_X = T_wm_b.unit_quaternion();
+  }
+  return t;
 }
 
 void Odometry::Impl::fail(const std::string& reason) {
@@ -140,6 +188,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   rec.T_f_ref = r.T_c_w * ref.state.T_c_w.inverse();
   record->addFrame(rec);
   tracking->pushHistory(rec.t_ns, rec.T_c_w, rec.keyframe);
+  fillInertial(rec.t_ns);
   {
     ScopedStage st(record->stages(), "trace");
     CandidateFrame target;
@@ -195,15 +244,24 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
       kf->twist_prior = tp;
     }
   }
+  if (inertial && !window->empty()) {
+    const std::string w = inertial->onNewKeyframe(*kf, &window->newest());
+    if (!w.empty()) record->addWarning(w);
+  }
   Keyframe& nk = window->insert(std::move(kf));
   {
     ScopedStage st(record->stages(), "activate");
     window->activateCandidates(nk);
   }
   {
+    ScopedStage st(record->stages(), "vi_init");
+    tryInertialInitialisation();
+  }
+  {
     ScopedStage st(record->stages(), "optimise");
     window->optimize(bo.max_iterations);
   }
+  if (inertial) inertial->refreshFactors(window->mutableKeyframes());
   for (const auto& k : window->keyframes()) record->recordKeyframe(*k);
   if (FrameRecord* f = record->frame(frame_index)) {
     f->keyframe = true;
@@ -214,6 +272,7 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
     f->affine = nk.state.affine;
   }
   tracking->keyframeOptimised(t_ns, nk.state.T_c_w);
+  fillInertial(t_ns);
   tracking->setReference(window->trackingReference(nk));
   {
     ScopedStage st(record->stages(), "marginalise");
@@ -230,8 +289,9 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
 void Odometry::Impl::checkDivergence() {
   if (failed || window->size() < 2) return;
   std::string warning;
-  const std::string reason = window->divergence(&warning);
+  std::string reason = window->divergence(&warning);
   if (!warning.empty()) record->addWarning(warning);
+  if (reason.empty() && inertial) reason = inertial->checkDivergence(window->keyframes());
   if (!reason.empty()) fail(reason);
 }
 
@@ -354,6 +414,7 @@ Odometry::~Odometry() = default;
 
 void Odometry::addImu(const ImuSample& sample) {
   for (auto& m : impl_->motion) m->addImu(sample);
+  if (impl_->inertial) impl_->inertial->addImu(sample);
 }
 
 FrameStatus Odometry::addFrame(const Frame& frame) {
@@ -390,18 +451,54 @@ bool Odometry::failed() const { return impl_->failed; }
 std::string Odometry::failureReason() const { return impl_->failure; }
 std::map<std::string, double> Odometry::stageMs() const { return impl_->record->stages().means(); }
 long Odometry::numKeyframes() const { return impl_->record->numKeyframes(); }
-bool Odometry::usesImu() const { return false; }
-double Odometry::scale() const { return 1.0; }
+bool Odometry::usesImu() const { return impl_->inertial && impl_->inertial->initialised(); }
+double Odometry::scale() const { return usesImu() ? impl_->inertial->scale() : 1.0; }
+nlohmann::json Odometry::inertialReport() const {
+  const Impl& m = *impl_;
+  if (!m.inertial) return nullptr;
+  nlohmann::json j;
+  j["initialised"] = m.inertial->initialised();
+  j["status"] = m.inertial->status();
+  if (m.inertial->initialised()) {
+    j["initialised_at_s"] = nsToS(m.vi_init_t_ns);
+    j["scale_at_initialisation"] = m.inertial->initialScale();
+    j["scale"] = m.inertial->scale();
+    const Vec3 g = m.inertial->globals().state.T_wm_wf.so3().inverse() * Vec3(0, 0, -1);
+    j["gravity_direction_wf"] = {g.x(), g.y(), g.z()};
+  }
+  j["time_offset_estimated"] = m.inertial->options().estimate_time_offset;
+  j["time_offset_ms"] = m.inertial->timeOffset() * 1e3;
+  return j;
+}
 std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }
 const DiagnosticsLog& Odometry::diagnostics() const { return impl_->record->diagnostics(); }
 void Odometry::takeDiagnostics(std::vector<ObservationRow>* rows) { impl_->record->takeObservations(rows); }
-void Odometry::takePoints(std::vector<MapPoint>* points) { impl_->record->takePoints(points); }
-
-io::Trajectory Odometry::frameTrajectory() const { return impl_->record->frameTrajectory(impl_->window->keyframes()); }
-io::Trajectory Odometry::keyframeTrajectory() const {
-  return impl_->record->keyframeTrajectory(impl_->window->keyframes());
+// Visual-inertial: points go out in W_m, mapped with T_Wm_Wf as it is when they are taken (points taken
+// before the initialisation stay in W_f; docs/vio.md).
+void Odometry::takePoints(std::vector<MapPoint>* points) {
+  const size_t n0 = points->size();
+  impl_->record->takePoints(points);
+  if (usesImu())
+    for (size_t i = n0; i < points->size(); ++i) impl_->toMetric(&(*points)[i]);
 }
-std::vector<MapPoint> Odometry::points() const { return impl_->record->points(impl_->window->keyframes()); }
-std::vector<StateRow> Odometry::states() const { return impl_->record->states(impl_->window->keyframes()); }
+
+io::Trajectory Odometry::frameTrajectory() const {
+  return impl_->toBody(impl_->record->frameTrajectory(impl_->window->keyframes()));
+}
+io::Trajectory Odometry::keyframeTrajectory() const {
+  return impl_->toBody(impl_->record->keyframeTrajectory(impl_->window->keyframes()));
+}
+std::vector<MapPoint> Odometry::points() const {
+  std::vector<MapPoint> out = impl_->record->points(impl_->window->keyframes());
+  if (usesImu())
+    for (MapPoint& p : out) impl_->toMetric(&p);
+  return out;
+}
+std::vector<StateRow> Odometry::states() const {
+  std::vector<StateRow> rows = impl_->record->states(impl_->window->keyframes());
+  if (usesImu())
+    for (StateRow& r : rows) r.scale = impl_->inertial->scale();  // the final scale (metres per W_f unit)
+  return rows;
+}
 
 }  // namespace rsvio

@@ -187,12 +187,18 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     StateRow s;
     s.t_ns = r.t_ns;
     s.twist = r.state.twist;
+    s.v = r.state.v_wm;
+    s.bg = r.state.bias_gyro;
+    s.ba = r.state.bias_accel;
     rows[r.t_ns] = s;
   }
   for (const auto& kf : window) {
     StateRow s;
     s.t_ns = kf->t_ns;
     s.twist = rolling_ ? kf->state.twist : (kf->has_observed_twist ? kf->observed_twist : Vec6::Zero());
+    s.v = kf->state.v_wm;
+    s.bg = kf->state.bias_gyro;
+    s.ba = kf->state.bias_accel;
     rows[kf->t_ns] = s;
   }
   std::vector<StateRow> out;

@@ -74,6 +74,7 @@ class RunRecord : public WindowSink {
   // The observed twist is computed (and cached in kf once both neighbours are tracked), then recorded.
   void recordFinal(Keyframe& kf);
   long numKeyframes() const { return static_cast<long>(keyframes_.size()); }
+  const std::map<int64_t, KeyframeRecord>& keyframeRecords() const { return keyframes_; }
 
   // WindowSink: what leaves the window.
   void observationLeaves(const ActivePoint& p, const ActiveObservation& o) override;

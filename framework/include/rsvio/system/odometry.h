@@ -72,6 +72,10 @@ class Odometry {
   long numKeyframes() const;
   bool usesImu() const;
   double scale() const;                            // metres per W_f unit (1 without IMU)
+  // Visual-inertial runs: {"initialised", "status" (why not, or how), "initialised_at_s", "scale",
+  // "scale_at_initialisation", "gravity_direction_wf", "time_offset_ms", "time_offset_estimated"};
+  // null for visual odometry. usesImu() is true once initialised.
+  nlohmann::json inertialReport() const;
   std::vector<std::string> warnings() const;
 
   struct Impl;
