@@ -3,7 +3,9 @@
 # and UndefinedBehaviorSanitizer into build-asan/ (or $RSVIO_ASAN_BUILD_DIR) and runs the whole ctest suite
 # there. Any sanitizer report makes its test fail (ASan aborts; UBSan does not recover). Leaks inside
 # third-party libraries (VTK, Mesa/X, fontconfig) are suppressed by library name in
-# scripts/lsan_suppressions.txt; nothing of rsvio's own is suppressed.
+# scripts/lsan_suppressions.txt; nothing of rsvio's own is suppressed. Mesa's GL driver (*_dri.so), which
+# libGL dlopens per X display and unloads with it, is kept loaded in this build (viz/src/vtk_helpers.h,
+# keepGlDriverLoaded): unloaded, what its globals held shows up as leaks from "<unknown module>".
 # Tests built with RSVIO_SANITIZE may use smaller problem sizes (they say so where they do).
 set -euo pipefail
 cd "$(dirname "$0")/.."
