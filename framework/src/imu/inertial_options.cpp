@@ -28,6 +28,11 @@ ParamTable inertialParamTable() {
                   "the linear estimate of |g| must lie within this fraction of 9.81"),
       paramDouble("accel_bias_prior_sigma_m_s2", d.accel_bias_prior_sigma_m_s2, 1e-6, 1e3, "m/s^2",
                   "zero-mean prior on the accelerometer bias in the initialisation"),
+      paramDouble("init_max_gyro_bias_rad_s", d.init_max_gyro_bias_rad_s, 0.0, 1e3, "rad/s",
+                  "refuse an initialisation whose gyro bias exceeds this (tried again at the next keyframe)"),
+      paramDouble("init_max_accel_bias_m_s2", d.init_max_accel_bias_m_s2, 0.0, 1e3, "m/s^2",
+                  "refuse an initialisation whose accelerometer bias exceeds this (the keyframe poses do not "
+                  "fit the IMU yet; tried again at the next keyframe)"),
       paramDouble("repreintegrate_gyro_bias_rad_s", d.repreintegrate_gyro_bias_rad_s, 0.0, 10.0, "rad/s",
                   "re-preintegrate an IMU factor when the gyro bias moved further from its linearisation"),
       paramDouble("repreintegrate_accel_bias_m_s2", d.repreintegrate_accel_bias_m_s2, 0.0, 100.0, "m/s^2",
@@ -41,6 +46,8 @@ ParamTable inertialParamTable() {
       paramDouble("fail_max_imu_chi2", d.fail_max_imu_chi2, 0.0, 1e300, "",
                   "the run fails when the mean whitened energy of the window's IMU factors exceeds this "
                   "(exploding IMU residuals; a consistent factor has about 15)"),
+      paramDouble("fail_grace_s", d.fail_grace_s, 0.0, 1e6, "s",
+                  "the IMU residual test starts this long after the initialisation (the scale settles first)"),
   };
 }
 
@@ -55,12 +62,15 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.init_min_accel_excitation_m_s2 = p.getDouble("init_min_accel_excitation_m_s2");
   o.init_max_gravity_norm_error = p.getDouble("init_max_gravity_norm_error");
   o.accel_bias_prior_sigma_m_s2 = p.getDouble("accel_bias_prior_sigma_m_s2");
+  o.init_max_gyro_bias_rad_s = p.getDouble("init_max_gyro_bias_rad_s");
+  o.init_max_accel_bias_m_s2 = p.getDouble("init_max_accel_bias_m_s2");
   o.repreintegrate_gyro_bias_rad_s = p.getDouble("repreintegrate_gyro_bias_rad_s");
   o.repreintegrate_accel_bias_m_s2 = p.getDouble("repreintegrate_accel_bias_m_s2");
   o.fail_max_gyro_bias_rad_s = p.getDouble("fail_max_gyro_bias_rad_s");
   o.fail_max_accel_bias_m_s2 = p.getDouble("fail_max_accel_bias_m_s2");
   o.fail_max_scale_change = p.getDouble("fail_max_scale_change");
   o.fail_max_imu_chi2 = p.getDouble("fail_max_imu_chi2");
+  o.fail_grace_s = p.getDouble("fail_grace_s");
   return o;
 }
 

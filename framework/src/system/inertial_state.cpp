@@ -122,6 +122,15 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
     status_ = r.status;
     return false;
   }
+  if (r.bias.gyro.norm() > o_.init_max_gyro_bias_rad_s || r.bias.accel.norm() > o_.init_max_accel_bias_m_s2) {
+    std::ostringstream os;
+    os << "initialisation refused: biases |b_g| " << r.bias.gyro.norm() << " rad/s, |b_a| " << r.bias.accel.norm()
+       << " m/s^2 above imu.init_max_gyro_bias_rad_s " << o_.init_max_gyro_bias_rad_s
+       << " / imu.init_max_accel_bias_m_s2 " << o_.init_max_accel_bias_m_s2
+       << " (the keyframe poses do not fit the IMU yet)";
+    status_ = os.str();
+    return false;
+  }
   globals_.state.T_wm_wf = r.T_wm_wf;
   scale_init_ = r.T_wm_wf.scale();
   for (auto& kf : window) {
@@ -131,6 +140,7 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
       if (kfs[i].t_ns == kf->t_ns) kf->state.v_wm = r.velocities_wm[i];
   }
   initialised_ = true;
+  init_t_ns_ = window.back()->t_ns;
   for (size_t k = 0; k < window.size(); ++k) {
     Keyframe& kf = *window[k];
     kf.imu_term = false;
@@ -246,7 +256,8 @@ std::string InertialState::checkDivergence(const KeyframeList& window) const {
       ++n;
     }
   }
-  if (n > 0 && !(chi2 / n <= o_.fail_max_imu_chi2)) {
+  const bool settled = !window.empty() && nsToS(window.back()->t_ns - init_t_ns_) >= o_.fail_grace_s;
+  if (n > 0 && (!std::isfinite(chi2) || (settled && !(chi2 / n <= o_.fail_max_imu_chi2)))) {
     os << "exploding IMU residuals: mean whitened energy " << chi2 / n << " per factor > imu.fail_max_imu_chi2 "
        << o_.fail_max_imu_chi2;
     return os.str();

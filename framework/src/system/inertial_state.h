@@ -92,6 +92,7 @@ class InertialState {
   std::unique_ptr<InertialTerm> term_;
   bool initialised_ = false;
   double scale_init_ = 1.0;
+  int64_t init_t_ns_ = 0;
   std::string status_ = "waiting for keyframes";
 };
 

@@ -23,6 +23,10 @@ struct InertialOptions {
   double init_min_accel_excitation_m_s2 = 0.25;
   double init_max_gravity_norm_error = 0.1;
   double accel_bias_prior_sigma_m_s2 = 0.1;  // zero-mean prior on b_a in the initialisation's refinement
+  // An initialisation whose biases exceed these is refused (the keyframe poses do not fit the IMU yet,
+  // e.g. the monocular start's early drift) and tried again at the next keyframe.
+  double init_max_gyro_bias_rad_s = 0.05;
+  double init_max_accel_bias_m_s2 = 0.5;
   // Re-preintegrate an IMU factor when the bias moved further than this from its linearisation.
   double repreintegrate_gyro_bias_rad_s = 0.01;
   double repreintegrate_accel_bias_m_s2 = 0.1;
@@ -30,7 +34,8 @@ struct InertialOptions {
   double fail_max_gyro_bias_rad_s = 0.5;
   double fail_max_accel_bias_m_s2 = 3.0;
   double fail_max_scale_change = 5.0;   // scale vs the initialisation's, either way
-  double fail_max_imu_chi2 = 1e4;       // mean whitened IMU factor energy per factor in the window
+  double fail_max_imu_chi2 = 1e5;       // mean whitened IMU factor energy per factor in the window
+  double fail_grace_s = 2.0;            // the residual test starts this long after the initialisation
 
   static InertialOptions fromParams(const Params& p);
 };
