@@ -11,6 +11,7 @@
 #include "rsvio/interfaces/camera.h"
 #include "rsvio/interfaces/motion_prior.h"
 #include "rsvio/plugin/host.h"
+#include "rsvio/plugin/plugin_api.h"
 
 namespace fs = std::filesystem;
 using namespace rsvio;
@@ -120,7 +121,10 @@ TEST(PluginHost, AbiMismatch) {
   TempPluginDir dir({"camera.badabi"});
   PluginHost host({dir.path()});
   const std::string msg = errorOf([&] { host.info("camera.badabi"); });
-  EXPECT_NE(msg.find("plugin ABI version 42, host expects 1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("plugin ABI version " + std::to_string(RSVIO_PLUGIN_ABI_VERSION + 41) + ", host expects " +
+                     std::to_string(RSVIO_PLUGIN_ABI_VERSION)),
+            std::string::npos)
+      << msg;
 }
 
 TEST(PluginHost, FingerprintMismatch) {
