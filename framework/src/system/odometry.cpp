@@ -142,7 +142,10 @@ void Odometry::Impl::toMetric(MapPoint* p) const {
 io::Trajectory Odometry::Impl::toBody(io::Trajectory t) const {
   if (!inertial || !inertial->initialised()) return t;
   t.frame = io::PoseFrame::kBody;
+  // Stamps on the IMU clock: t_imu = t_cam + time offset (the final estimate when it is estimated).
+  const int64_t offset_ns = sToNs(inertial->timeOffset());
   for (io::StampedPose& p : t.poses) {
+    p.t_ns += offset_ns;
     const SE3d T_c_w = SE3d(p.q_W_X, p.p_W_X).inverse();
     const SE3d T_wm_b = inertial->bodyPose(T_c_w);
     p.p_W_X = T_wm_b.translation();

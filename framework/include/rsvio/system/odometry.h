@@ -6,7 +6,8 @@
 // - Frames arrive in order; before addFrame(f), every IMU sample with t_imu <= f.t_ns + time offset
 //   (+ the frame's readout) has been given to addImu (the run loop guarantees it).
 // - World: VO: the first keyframe's camera frame, free scale ("# frame: camera" outputs);
-//   VIO: the metric world W_m, z up, after initialisation ("# frame: body" outputs).
+//   VIO: the metric world W_m, z up, after initialisation ("# frame: body" outputs, stamped on the IMU
+//   clock t_cam + time offset).
 // - status(): "ok" while running; after a divergence (exploding energy, scale collapse, too few
 //   inliers, tracking lost without recovery) "failed" with a one-line reason. Once failed, further
 //   frames are ignored; what was estimated before the failure stays available.
