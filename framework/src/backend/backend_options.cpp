@@ -122,16 +122,7 @@ void BackendOptions::validate() const {
 }
 
 BackendOptions backendOptionsFromConfig(const nlohmann::json& effective_config) {
-  const nlohmann::json section =
-      effective_config.contains("backend") ? effective_config.at("backend") : nlohmann::json::object();
-  std::vector<ConfigProblem> problems;
-  const nlohmann::json filled = validateParams(section, backendParamTable(), "backend", problems);
-  if (!problems.empty()) {
-    std::string msg = "backend: " + std::to_string(problems.size()) + " problem(s)";
-    for (const ConfigProblem& p : problems) msg += "\n" + p.str();
-    throw ConfigError(msg);
-  }
-  return BackendOptions::fromParams(Params(filled, "backend"));
+  return BackendOptions::fromParams(sectionParams(effective_config, "backend", backendParamTable()));
 }
 
 }  // namespace rsvio

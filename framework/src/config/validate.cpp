@@ -308,4 +308,17 @@ Params slotParams(const nlohmann::json& effective, const std::string& path) {
   return Params(node->contains("params") ? node->at("params") : nlohmann::json::object(), path + ".params");
 }
 
+Params sectionParams(const nlohmann::json& effective_config, const std::string& section, const ParamTable& table) {
+  const nlohmann::json node =
+      effective_config.contains(section) ? effective_config.at(section) : nlohmann::json::object();
+  std::vector<ConfigProblem> problems;
+  const nlohmann::json filled = validateParams(node, table, section, problems);
+  if (!problems.empty()) {
+    std::string msg = section + ": " + std::to_string(problems.size()) + " problem(s)";
+    for (const ConfigProblem& p : problems) msg += "\n" + p.str();
+    throw ConfigError(msg);
+  }
+  return Params(filled, section);
+}
+
 }  // namespace rsvio

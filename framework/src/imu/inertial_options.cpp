@@ -75,15 +75,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
 }
 
 InertialOptions inertialOptionsFromConfig(const nlohmann::json& effective_config) {
-  const nlohmann::json section = effective_config.contains("imu") ? effective_config.at("imu") : nlohmann::json::object();
-  std::vector<ConfigProblem> problems;
-  const nlohmann::json filled = validateParams(section, inertialParamTable(), "imu", problems);
-  if (!problems.empty()) {
-    std::string msg = "imu: " + std::to_string(problems.size()) + " problem(s)";
-    for (const ConfigProblem& p : problems) msg += "\n" + p.str();
-    throw ConfigError(msg);
-  }
-  return InertialOptions::fromParams(Params(filled, "imu"));
+  return InertialOptions::fromParams(sectionParams(effective_config, "imu", inertialParamTable()));
 }
 
 }  // namespace rsvio

@@ -52,15 +52,7 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
       motion.back()->setSensors(sensors);
     }
   // Sections with defaults filled (the run schema registers them; a config without them still runs).
-  std::vector<ConfigProblem> problems;
-  const nlohmann::json fe = validateParams(cfg.contains("frontend") ? cfg.at("frontend") : nlohmann::json::object(),
-                                           frontendParamTable(), "frontend", problems);
-  if (!problems.empty()) {
-    std::string msg = "frontend: " + std::to_string(problems.size()) + " problem(s)";
-    for (const ConfigProblem& p : problems) msg += "\n" + p.str();
-    throw ConfigError(msg);
-  }
-  fo = frontendOptions(Params(fe, "frontend"), seed, threads);
+  fo = frontendOptions(sectionParams(cfg, "frontend", frontendParamTable()), seed, threads);
   bo = backendOptionsFromConfig(cfg);
 
   timing = RowTiming::from(*shutter, *camera);

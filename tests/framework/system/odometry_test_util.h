@@ -56,13 +56,16 @@ struct RunOutcome {
   std::vector<std::string> messages;
   std::map<std::string, double> stage_ms;
   size_t diagnostics_rows = 0;
-  double ate_rmse_m = -1.0;     // keyframes, Sim(3), against the dataset's camera ground truth
+  double ate_rmse_m = -1.0;     // keyframes, Sim(3), against the dataset's camera ground truth (VO)
   double path_m = 0.0;
+  nlohmann::json vio;           // Odometry::inertialReport() (null for VO)
 };
 
 // Feeds the dataset to the estimator. `modify(i, frame)` may replace images (broken-input tests).
+// `imu_modify(sample)` may change IMU samples before the estimator sees them.
 inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& cfg, long max_frames = -1,
-                             const std::function<void(size_t, Frame&)>& modify = nullptr) {
+                             const std::function<void(size_t, Frame&)>& modify = nullptr,
+                             const std::function<void(ImuSample&)>& imu_modify = nullptr) {
   PluginHost& host = contractHost();
   auto source = host.create<DataSource>(cfg.at("source").at("plugin").get<std::string>(), slotParams(cfg, "source"));
   source->open(dataset);
@@ -73,7 +76,11 @@ inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& c
   const size_t n = max_frames > 0 ? std::min<size_t>(max_frames, source->numFrames()) : source->numFrames();
   for (size_t i = 0; i < n; ++i) {
     Frame f = source->readFrame(i);
-    while (k < imu.size() && imu[k].t_ns <= f.t_ns) odo.addImu(imu[k++]);
+    while (k < imu.size() && imu[k].t_ns <= f.t_ns) {
+      ImuSample s = imu[k++];
+      if (imu_modify) imu_modify(s);
+      odo.addImu(s);
+    }
     if (modify) modify(i, f);
     const FrameStatus s = odo.addFrame(f);
     ++out.frames;
@@ -94,9 +101,10 @@ inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& c
   out.kf_traj = odo.keyframeTrajectory();
   out.stage_ms = odo.stageMs();
   out.diagnostics_rows = odo.diagnostics().observations.size();
+  out.vio = odo.inertialReport();
   // Camera ground truth: body poses mapped through the calibration's T_B_C.
   const auto gt_path = io::findDatasetGroundTruth(dataset);
-  if (gt_path && out.kf_traj.size() >= 3) {
+  if (gt_path && out.kf_traj.size() >= 3 && out.kf_traj.frame == io::PoseFrame::kCamera) {
     io::Trajectory gt = io::readGroundTruth(*gt_path);
     const Eigen::Isometry3d T_B_C = source->sensors().camera.T_B_C;
     for (io::StampedPose& p : gt.poses) {

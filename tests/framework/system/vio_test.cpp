@@ -16,49 +16,16 @@ namespace {
 using test::runConfig;
 using test::simDataset;
 
-struct VioOutcome {
-  bool failed = false;
-  std::string reason;
-  long frames = 0, tracked = 0, untracked_after_first = 0;
-  long first_tracked = -1;
-  nlohmann::json vio;
-  io::Trajectory kf_traj;
-  double ate_se3_m = -1, sim3_scale = 0, tilt_deg = 180, path_m = 0, ate_sim3_m = -1;
+struct VioOutcome : test::RunOutcome {
+  double ate_se3_m = -1, sim3_scale = 0, tilt_deg = 180, ate_sim3_m = -1;
 };
 
-// Feeds the dataset (IMU samples through `imu_modify`) and evaluates body-frame keyframes against the
-// body ground truth (SE(3) and Sim(3)); camera-frame estimates are not evaluated here.
+// runDataset (odometry_test_util.h), then body-frame keyframes against the body ground truth (SE(3)
+// and Sim(3)); camera-frame estimates are not evaluated here.
 VioOutcome runVio(const std::string& dataset, const nlohmann::json& cfg,
                   const std::function<void(ImuSample&)>& imu_modify = nullptr) {
-  PluginHost& host = test::contractHost();
-  auto source = host.create<DataSource>(cfg.at("source").at("plugin").get<std::string>(), slotParams(cfg, "source"));
-  source->open(dataset);
-  Odometry odo(cfg, host, source->sensors());
   VioOutcome out;
-  const std::vector<ImuSample>& imu = source->imu();
-  size_t k = 0;
-  for (size_t i = 0; i < source->numFrames(); ++i) {
-    Frame f = source->readFrame(i);
-    while (k < imu.size() && imu[k].t_ns <= f.t_ns) {
-      ImuSample s = imu[k++];
-      if (imu_modify) imu_modify(s);
-      odo.addImu(s);
-    }
-    const FrameStatus st = odo.addFrame(f);
-    ++out.frames;
-    if (st.tracked) {
-      ++out.tracked;
-      if (out.first_tracked < 0) out.first_tracked = static_cast<long>(i);
-    } else if (out.first_tracked >= 0) {
-      ++out.untracked_after_first;
-    }
-    if (odo.failed()) break;
-  }
-  odo.finish();
-  out.failed = odo.failed();
-  out.reason = odo.failureReason();
-  out.vio = odo.inertialReport();
-  out.kf_traj = odo.keyframeTrajectory();
+  static_cast<test::RunOutcome&>(out) = test::runDataset(dataset, cfg, -1, nullptr, imu_modify);
   const auto gt_path = io::findDatasetGroundTruth(dataset);
   if (gt_path && out.kf_traj.frame == io::PoseFrame::kBody && out.kf_traj.size() >= 3) {
     io::Trajectory gt = io::readGroundTruth(*gt_path);

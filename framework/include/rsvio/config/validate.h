@@ -60,6 +60,11 @@ nlohmann::json validateConfig(const nlohmann::json& config, const ConfigSchema& 
 nlohmann::json validateParams(const nlohmann::json& params, const ParamTable& table, const std::string& path,
                               std::vector<ConfigProblem>& problems);
 
+// The section `section` of an effective config (an empty object when absent) validated against its
+// table, defaults filled, as Params; problems (wrong type, unknown key) throw ConfigError listing each
+// with its JSON path ("<section>: N problem(s)").
+Params sectionParams(const nlohmann::json& effective_config, const std::string& section, const ParamTable& table);
+
 // Did-you-mean: the closest candidate by edit distance, or "" when nothing is close.
 std::string didYouMean(const std::string& word, const std::vector<std::string>& candidates);
 
