@@ -199,7 +199,8 @@ TEST_F(Newcomer, RollingShutterWithoutLineDelaySaysHowToGiveIt) {
   // Whether shutter.rolling offers estimate_line_delay: its parameter table, as rsvio plugins lists it.
   bool can_estimate = false;
   const Result pl = rsvio("plugins --json");
-  for (const auto& p : nlohmann::json::parse(pl.out)["plugins"])
+  const nlohmann::json listing = nlohmann::json::parse(pl.out);  // named: a loop over a temporary's member dangles
+  for (const auto& p : listing["plugins"])
     if (p["name"] == "shutter.rolling")
       for (const auto& q : p["params"]) can_estimate |= q["key"] == "estimate_line_delay";
   EXPECT_EQ(r.err.find("shutter.params.estimate_line_delay=true") != std::string::npos, can_estimate) << r.err;
