@@ -13,14 +13,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "commands.h"
 #include "diagnose.h"
 #include "rsvio/config/config.h"
 #include "rsvio/core/error.h"
+#include "rsvio/interfaces/data_source.h"
 #include "rsvio/interfaces/diagnostic_probe.h"
 #include "rsvio/io/diagnostics_log.h"
+#include "rsvio/io/trajectory.h"
 #include "rsvio/plugin/host.h"
 #include "rsvio/config/validate.h"
 #ifdef RSVIO_HAVE_VIZ
@@ -51,9 +55,42 @@ struct LoadedRun {
   nlohmann::json config;
   nlohmann::json report;
   DiagnosticsLog log;
+  std::optional<io::Trajectory> trajectory;  // trajectory.tum, when the run wrote one
+  std::unique_ptr<DataSource> dataset;       // the run's dataset (report.json "dataset"), when it opens
+  std::string dataset_note;                  // why it is not there
+
+  ProbeInput input(const DiagnosticsLog& l, const nlohmann::json& cfg) const {
+    ProbeInput in{l, cfg};
+    in.run_config = &config;
+    if (trajectory) in.trajectory = &*trajectory;
+    if (dataset) {
+      in.sensors = &dataset->sensors();
+      if (dataset->sensors().has_imu) in.imu = &dataset->imu();
+    }
+    return in;
+  }
 };
 
-LoadedRun loadRun(const std::string& dir) {
+// The dataset's measurements (IMU, calibration) through the run's own source plugin. Never ground
+// truth: DataSource::open reads the index files and calibration only. A dataset that moved or no longer
+// opens leaves the probes that need it without data (they say so); it does not stop the diagnosis.
+void openDataset(LoadedRun& r, PluginHost& host) {
+  if (!r.report.is_object() || !r.report.contains("dataset") || !r.report["dataset"].is_string()) {
+    r.dataset_note = "report.json names no dataset";
+    return;
+  }
+  const std::string dir = r.report["dataset"].get<std::string>();
+  try {
+    auto src = host.create<DataSource>(r.config.at("source").at("plugin").get<std::string>(),
+                                       slotParams(r.config, "source"), "source");
+    src->open(dir);
+    r.dataset = std::move(src);
+  } catch (const std::exception& e) {
+    r.dataset_note = dir + ": the run's dataset does not open (" + e.what() + ")";
+  }
+}
+
+LoadedRun loadRun(const std::string& dir, PluginHost& host) {
   const fs::path d(dir);
   if (!fs::is_directory(d)) throw DataError(dir + ": no such run folder");
   LoadedRun r;
@@ -63,6 +100,15 @@ LoadedRun loadRun(const std::string& dir) {
   if (!fs::exists(dl))
     throw DataError(dl.string() + ": missing (the run wrote no diagnostics log; output.diagnostics must be true)");
   r.log = DiagnosticsLog::read(dl.string());
+  const fs::path tum = d / "trajectory.tum";
+  if (fs::exists(tum)) {
+    try {
+      r.trajectory = io::readTum(tum.string());
+    } catch (const std::exception& e) {
+      std::cerr << "rsvio diagnose: " << e.what() << " (probes that need the trajectory have no data)\n";
+    }
+  }
+  openDataset(r, host);
   return r;
 }
 
@@ -104,13 +150,12 @@ nlohmann::json runSummary(const nlohmann::json& report) {
 }
 
 // Evaluates every probe; applicable ones ranked by score, the others listed with why.
-void evaluateAll(const DiagnosticsLog& log, const nlohmann::json& config, PluginHost& host, nlohmann::json& ranking,
-                 nlohmann::json& not_applicable) {
+void evaluateAll(const ProbeInput& in, PluginHost& host, nlohmann::json& ranking, nlohmann::json& not_applicable) {
   ranking = nlohmann::json::array();
   not_applicable = nlohmann::json::array();
   std::vector<ProbeResult> res;
   for (auto& [name, probe] : makeProbes(host)) {
-    ProbeResult r = probe->evaluate(log, config);
+    ProbeResult r = probe->evaluate(in);
     if (r.effect.empty()) r.effect = probe->effect();
     if (!r.applicable) {
       not_applicable.push_back({{"effect", r.effect}, {"plugin", r.plugin}, {"why", r.explanation}, {"probe", name}});
@@ -248,7 +293,7 @@ std::string fmt(double v, int prec = 3) {
 }  // namespace
 
 nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
-  LoadedRun run = loadRun(req.run_dir);
+  LoadedRun run = loadRun(req.run_dir, host);
   nlohmann::json d;
   d["run"] = req.run_dir;
   d["run_status"] = runSummary(run.report);
@@ -273,9 +318,12 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
                  {"pairs", pairs.size()},
                  {"span_s", usable ? 1e-9 * static_cast<double>(t1 - t0) : 0.0},
                  {"imu_rows", run.log.imu.size()}};
+    d["data"]["trajectory_poses"] = run.trajectory ? run.trajectory->poses.size() : 0;
+    d["data"]["dataset_imu_samples"] = run.dataset && run.dataset->sensors().has_imu ? run.dataset->imu().size() : 0;
+    if (!run.dataset_note.empty()) d["data"]["dataset_note"] = run.dataset_note;
   }
   nlohmann::json ranking, na;
-  evaluateAll(run.log, run.config, host, ranking, na);
+  evaluateAll(run.input(run.log, run.config), host, ranking, na);
   // A model that can refine the value the line sets (online estimation) is told to: e.g.
   // shutter.rolling's estimate_line_delay, when the installed plugin has that parameter.
   for (auto& e : ranking) {
@@ -305,16 +353,16 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
   bool have_after = false;
   if (!req.against.empty()) {
     // --against A: A is the run before the change, this run the one after.
-    LoadedRun before = loadRun(req.against);
+    LoadedRun before = loadRun(req.against, host);
     nlohmann::json b_rank, b_na;
-    evaluateAll(before.log, before.config, host, b_rank, b_na);
+    evaluateAll(before.input(before.log, before.config), host, b_rank, b_na);
     const std::string b_verdict = effectOf(b_rank);
     // The new run's residuals judged as if nothing had been added (the before run's config; a modelled
     // line delay hidden), so that "is the evidence gone" is asked of the same probe.
     DiagnosticsLog as_before = run.log;
     as_before.line_delay_s = 0.0;
     nlohmann::json a_rank, a_na;
-    evaluateAll(as_before, before.config, host, a_rank, a_na);
+    evaluateAll(run.input(as_before, before.config), host, a_rank, a_na);
     nlohmann::json cmp;
     cmp["before_run"] = req.against;
     cmp["before"] = runSummary(before.report);

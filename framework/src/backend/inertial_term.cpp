@@ -41,15 +41,6 @@ double accumulate(const Eigen::VectorXd& r, const Eigen::MatrixXd& W, const std:
   return r.dot(Wr);
 }
 
-VisualInertialKeyframe viState(const Keyframe& k) {
-  VisualInertialKeyframe v;
-  v.T_cf_wf = k.state.T_c_w;
-  v.v_wm = k.state.v_wm;
-  v.bias.gyro = k.state.bias_gyro;
-  v.bias.accel = k.state.bias_accel;
-  return v;
-}
-
 Mat6 twistWeight(const InertialTermOptions& o, double scale) {
   Mat6 W = Mat6::Zero();
   const double it = (scale / o.twist_sigma_trans_m_s) * (scale / o.twist_sigma_trans_m_s);
@@ -64,8 +55,8 @@ bool imuFactorCols(const Keyframe& j, const GlobalStates& g, const SE3d& T_cm_i,
   if (!j.imu_term || !j.imu_prev || !j.imu_factor) return false;
   const Keyframe& i = *j.imu_prev;
   VisualInertialJacobians J;
-  *r = visualInertialResidual(*j.imu_factor, viState(i), viState(j), g.state.T_wm_wf, T_cm_i, g.state.time_offset_s,
-                              cols ? &J : nullptr);
+  *r = visualInertialResidual(*j.imu_factor, visualInertialStateOf(i), visualInertialStateOf(j), g.state.T_wm_wf,
+                              T_cm_i, g.state.time_offset_s, cols ? &J : nullptr);
   *W = o.imu_weight * j.imu_factor->information();
   if (!cols) return true;
   cols->clear();
@@ -97,6 +88,15 @@ bool twistCols(const Keyframe& k, const GlobalStates& g, const SE3d& T_cm_i, con
 }
 
 }  // namespace
+
+VisualInertialKeyframe visualInertialStateOf(const Keyframe& k) {
+  VisualInertialKeyframe v;
+  v.T_cf_wf = k.state.T_c_w;
+  v.v_wm = k.state.v_wm;
+  v.bias.gyro = k.state.bias_gyro;
+  v.bias.accel = k.state.bias_accel;
+  return v;
+}
 
 double InertialTerm::linearize(const KeyframeList& window, const StateLayout& layout, Eigen::MatrixXd& H,
                                Eigen::VectorXd& b) const {

@@ -17,7 +17,10 @@ ParamTable inertialParamTable() {
                   "weight beta of the twist energy (paper eq. 34; rolling shutter with motion.imu)"),
       paramBool("estimate_time_offset", d.estimate_time_offset,
                 "estimate the camera-IMU time offset online (t_imu = t_cam + offset, Kalibr's sign); starts "
-                "from the calibration's"),
+                "from the calibration's (plus time_offset_correction_ms)"),
+      paramDouble("time_offset_correction_ms", d.time_offset_correction_ms, -1000.0, 1000.0, "ms",
+                  "added to the calibration's camera-IMU time offset (t_imu = t_cam + offset): the value rsvio "
+                  "diagnose measures when the calibration lacks it"),
       paramInt("init_min_keyframes", d.init_min_keyframes, 3, 1000, "",
                "keyframes before the visual-inertial initialisation is tried"),
       paramDouble("init_min_duration_s", d.init_min_duration_s, 0.0, 1e6, "s",
@@ -57,6 +60,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.imu_weight = p.getDouble("imu_weight");
   o.twist_weight = p.getDouble("twist_weight");
   o.estimate_time_offset = p.getBool("estimate_time_offset");
+  o.time_offset_correction_ms = p.getDouble("time_offset_correction_ms");
   o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));
   o.init_min_duration_s = p.getDouble("init_min_duration_s");
   o.init_min_accel_excitation_m_s2 = p.getDouble("init_min_accel_excitation_m_s2");

@@ -6,6 +6,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include "rsvio/core/time.h"
 #include "rsvio/eval/eval_output.h"
 #include "rsvio/eval/evaluate_files.h"
+#include "rsvio/imu/inertial_options.h"
 #include "rsvio/interfaces/data_source.h"
 #include "rsvio/io/diagnostics_log.h"
 #include "rsvio/io/ply.h"
@@ -244,7 +246,9 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   size_t imu_next = 0;
   const size_t n = source->numFrames();
   const double rate = sensors.camera.rate_hz > 0 ? sensors.camera.rate_hz : 20.0;
-  const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(sensors.camera.time_offset_s);
+  // IMU samples up to half a frame past the frame's time on the IMU clock (more is harmless).
+  const double offset_s = sensors.camera.time_offset_s + 1e-3 * inertialOptionsFromConfig(cfg).time_offset_correction_ms;
+  const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(std::abs(offset_s));
   auto last_print = Clock::now();
   long processed = 0;
   auto interrupted = [&] {

@@ -82,9 +82,7 @@ std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
     linkTwistEnergy(kf);
     return os.str();
   }
-  ImuState si;
-  setPose(&si, imuPoseFromCamera(newest->state.T_c_w, globals_.state.T_wm_wf, T_cm_i_));
-  si.v_w = newest->state.v_wm;
+  ImuState si = imuStateOf(visualInertialStateOf(*newest), globals_.state.T_wm_wf, T_cm_i_);
   si.bias = f->preintegration().biasLin();
   kf.state.v_wm = predictState(si, f->preintegration()).v_w;
   kf.imu_prev = newest;
@@ -275,11 +273,7 @@ void InertialState::fillMotionState(const Keyframe& ref, MotionState* ms) const 
   ms->v_wm = ref.state.v_wm;
   const int64_t off = offsetNs();
   if (ms->t_ns <= ref.t_ns || !buffer_.covers(ref.t_ns + off, ms->t_ns + off)) return;
-  ImuState si;
-  setPose(&si, imuPoseFromCamera(ref.state.T_c_w, globals_.state.T_wm_wf, T_cm_i_));
-  si.v_w = ref.state.v_wm;
-  si.bias.gyro = ref.state.bias_gyro;
-  si.bias.accel = ref.state.bias_accel;
+  const ImuState si = imuStateOf(visualInertialStateOf(ref), globals_.state.T_wm_wf, T_cm_i_);
   const ImuPreintegration pre = ImuPreintegration::fromBuffer(buffer_, ref.t_ns, ms->t_ns, sensors_.imu, si.bias,
                                                               globals_.state.time_offset_s);
   ms->v_wm = predictState(si, pre).v_w;

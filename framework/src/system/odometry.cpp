@@ -29,6 +29,9 @@ std::unique_ptr<I> makeSlot(PluginHost& host, const nlohmann::json& cfg, const s
 }  // namespace
 
 Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSetup& s) : config(cfg), sensors(s) {
+  const InertialOptions io = inertialOptionsFromConfig(cfg);
+  // The offset every part uses (t_imu = t_cam + offset): the calibration's plus imu.time_offset_correction_ms.
+  sensors.camera.time_offset_s += 1e-3 * io.time_offset_correction_ms;
   seed = static_cast<uint64_t>(cfg.value("seed", 0L));
   threads = std::clamp(static_cast<int>(cfg.value("threads", 1L)), 1, 2);
   for (const char* slot : {"camera", "shutter", "solver"})
@@ -92,7 +95,6 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   tracking = std::make_unique<Tracking>(to, *camera, timing, motion_ptrs);
   window = std::make_unique<KeyframeWindow>(ws, *camera, timing, *solver);
   start = std::make_unique<MonoStart>(bo, *camera);
-  const InertialOptions io = inertialOptionsFromConfig(cfg);
   if (io.enabled) {
     if (!sensors.has_imu)
       throw ConfigError("imu.enabled: the dataset " + sensors.dataset_dir +

@@ -24,7 +24,8 @@ class DistortionProbe : public DiagnosticProbe {
   explicit DistortionProbe(const Params& p) : threshold_(p.getDouble("threshold")) {}
   std::string effect() const override { return "distortion"; }
 
-  ProbeResult evaluate(const DiagnosticsLog& log, const nlohmann::json&) const override {
+  ProbeResult evaluate(const ProbeInput& in) const override {
+    const DiagnosticsLog& log = in.log;
     const double cx = 0.5 * (log.width - 1), cy = 0.5 * (log.height - 1);
     const auto x_of = [cx, cy](const ObservationRow& o) {
       return -(static_cast<double>(o.grad_u) * (o.u - cx) + static_cast<double>(o.grad_v) * (o.v - cy)) * o.radius *

@@ -25,7 +25,9 @@ class ExposureProbe : public DiagnosticProbe {
   explicit ExposureProbe(const Params& p) : threshold_(p.getDouble("threshold")) {}
   std::string effect() const override { return "exposure"; }
 
-  ProbeResult evaluate(const DiagnosticsLog& log, const nlohmann::json& cfg) const override {
+  ProbeResult evaluate(const ProbeInput& in) const override {
+    const DiagnosticsLog& log = in.log;
+    const nlohmann::json& cfg = in.config;
     if (probe::usesPlugin(cfg, "photometric.affine"))
       return probe::notApplicable(effect(), "photometric.affine",
                                   "the run models brightness changes (photometric.affine)");

@@ -23,7 +23,9 @@ class ResponseProbe : public DiagnosticProbe {
   explicit ResponseProbe(const Params& p) : threshold_(p.getDouble("threshold")) {}
   std::string effect() const override { return "response"; }
 
-  ProbeResult evaluate(const DiagnosticsLog& log, const nlohmann::json& cfg) const override {
+  ProbeResult evaluate(const ProbeInput& in) const override {
+    const DiagnosticsLog& log = in.log;
+    const nlohmann::json& cfg = in.config;
     if (probe::usesPlugin(cfg, "photometric.response"))
       return probe::notApplicable(effect(), "photometric.response", "the run models the response (photometric.response)");
     const auto x_of = [](const ObservationRow& o) {

@@ -87,7 +87,9 @@ class RollingShutterProbe : public DiagnosticProbe {
         readout_fraction_(p.getDouble("readout_fraction")) {}
   std::string effect() const override { return "rolling_shutter"; }
 
-  ProbeResult evaluate(const DiagnosticsLog& log, const nlohmann::json& cfg) const override {
+  ProbeResult evaluate(const ProbeInput& in) const override {
+    const DiagnosticsLog& log = in.log;
+    const nlohmann::json& cfg = in.config;
     if (probe::usesPlugin(cfg, "shutter.rolling") || log.line_delay_s > 0)
       return probe::notApplicable(effect(), "shutter.rolling", "the run models a rolling shutter (shutter.rolling)");
     // The host's own rolling shutter displaced the point the model back-projected: what the residual

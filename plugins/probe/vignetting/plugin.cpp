@@ -25,7 +25,9 @@ class VignettingProbe : public DiagnosticProbe {
       : threshold_(p.getDouble("threshold")), gain_(p.getDouble("estimate_gain")) {}
   std::string effect() const override { return "vignetting"; }
 
-  ProbeResult evaluate(const DiagnosticsLog& log, const nlohmann::json& cfg) const override {
+  ProbeResult evaluate(const ProbeInput& in) const override {
+    const DiagnosticsLog& log = in.log;
+    const nlohmann::json& cfg = in.config;
     if (probe::usesPlugin(cfg, "photometric.vignette"))
       return probe::notApplicable(effect(), "photometric.vignette", "the run models vignetting (photometric.vignette)");
     const auto x_of = [](const ObservationRow& o) {

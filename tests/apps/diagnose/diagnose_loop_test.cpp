@@ -49,6 +49,8 @@ const std::string kExposure =
     "'effects.exposure={\"plugin\":\"effect.exposure\",\"params\":{\"amplitude_stops\":0.5,\"period_s\":8.0,"
     "\"jitter_stops\":0.03}}'";
 const std::string kVignette = "'effects.vignette={\"plugin\":\"effect.vignette\"}'";
+const std::string kTimeOffset =
+    "'effects.time_offset={\"plugin\":\"effect.time_offset\",\"params\":{\"offset_ms\":20.0}}'";
 
 void simulate(const fs::path& data, int seed, const std::string& set = "", const std::string& cfg = "tiny_gs.json") {
   ASSERT_EQ(rsvio("simulate --config " + configs() + "/sim/" + cfg + " --out " + data.string() + " --seed " +
@@ -56,10 +58,12 @@ void simulate(const fs::path& data, int seed, const std::string& set = "", const
             0);
 }
 
-// rsvio run of gs_vo with extra --set lines; returns report.json (status may be "failed": exit 1).
-nlohmann::json run(const fs::path& data, const fs::path& out, const std::string& sets) {
-  const int rc = rsvio("run --config " + configs() + "/gs_vo.json --data " + data.string() + " --out " + out.string() +
-                       " " + sets);
+// rsvio run of `config` (gs_vo unless said) with extra --set lines; returns report.json (status may be
+// "failed": exit 1).
+nlohmann::json run(const fs::path& data, const fs::path& out, const std::string& sets,
+                   const std::string& config = "gs_vo.json") {
+  const int rc = rsvio("run --config " + configs() + "/" + config + " --data " + data.string() + " --out " +
+                       out.string() + " " + sets);
   EXPECT_TRUE(rc == 0 || rc == 1) << "rsvio run exit " << rc;
   std::ifstream in(out / "report.json");
   return in ? nlohmann::json::parse(in) : nlohmann::json();
@@ -94,14 +98,14 @@ void checkContractShape(const nlohmann::json& d) {
 // The loop for one effect: the diagnosis names `effect` first, its line makes the ATE fall by
 // `min_ratio`, the evidence is gone in the new run.
 void loop(const fs::path& dir, const fs::path& data, const std::string& base_sets, const std::string& effect,
-          double min_ratio, bool evidence_must_go = true) {
-  const nlohmann::json before = run(data, dir / "before", base_sets);
+          double min_ratio, bool evidence_must_go = true, const std::string& config = "gs_vo.json") {
+  const nlohmann::json before = run(data, dir / "before", base_sets, config);
   const nlohmann::json d = diagnose(dir / "before");
   checkContractShape(d);
   ASSERT_EQ(d["verdict"], effect) << d.dump(1);
   ASSERT_EQ(d["ranking"][0]["effect"], effect);
   const std::string line = d["config_line"];
-  const nlohmann::json after = run(data, dir / "after", base_sets + " " + line);
+  const nlohmann::json after = run(data, dir / "after", base_sets + " " + line, config);
   EXPECT_EQ(after.value("status", ""), "ok") << after.dump(1);
   EXPECT_GT(ate(before), min_ratio * ate(after)) << "ATE before " << ate(before) << " after " << ate(after)
                                                   << " with " << line;
@@ -162,6 +166,61 @@ TEST(DiagnoseLoop, RollingShutterNamedAndTheRollingShutterModelMakesTheErrorFall
   const fs::path dir = workDir("rolling_shutter");
   simulate(dir / "data", 3, "", "tiny_rs.json");
   loop(dir, dir / "data", "", "rolling_shutter", 2.0);
+}
+
+// Camera-IMU time offset (the image stamped t_cam is captured at IMU time t_cam + 20 ms), starting from
+// configs/default.json (visual-inertial, offset not estimated), seed 1: named (|z| 15.2, a shift
+// explains 78 % of the misfit, estimate 19.8 ms), the line (imu.time_offset_correction_ms=19.8 and
+// imu.estimate_time_offset=true) takes the ATE from 113 mm to 5.1 mm (22x; final offset 20.26 ms),
+// evidence 2.53 -> 0.6; asked: 2x. The probe reads the dataset's IMU and the run's trajectory, not the
+// diagnostics log; without truth.json and ground truth it gives the same statistic.
+TEST(DiagnoseLoop, TimeOffsetNamedAndEstimatingItMakesTheErrorFall) {
+  const fs::path dir = workDir("time_offset");
+  simulate(dir / "data", 1, kTimeOffset);
+  loop(dir, dir / "data", "", "time_offset", 2.0, true, "default.json");
+  const nlohmann::json d = diagnose(dir / "before", "--no-figures");
+  ASSERT_EQ(d["ranking"][0]["effect"], "time_offset");
+  const double est = d["ranking"][0]["details"]["offset_estimate_ms"];
+  EXPECT_NEAR(est, 20.0, 4.0) << "the probe's estimate of the missing offset";
+  fs::copy(dir / "data", dir / "blind", fs::copy_options::recursive);
+  fs::remove(dir / "blind" / "truth.json");
+  fs::remove_all(dir / "blind" / "mav0" / "state_groundtruth_estimate0");
+  fs::remove_all(dir / "blind" / "mav0" / "mocap0");
+  run(dir / "blind", dir / "blind_run", "", "default.json");
+  const nlohmann::json b = diagnose(dir / "blind_run", "--no-figures");
+  EXPECT_EQ(b["ranking"][0]["effect"], "time_offset");
+  EXPECT_EQ(b["ranking"][0]["statistic"], d["ranking"][0]["statistic"]);
+}
+
+// The time-offset probe on clean visual-inertial runs (default.json, seeds 1 and 3: |z| 1.3 and 0.1),
+// and not applicable to visual odometry (the IMU does not enter its model) or to a run that estimates
+// the offset.
+TEST(DiagnoseLoop, TimeOffsetProbeStaysQuietOnCleanDataAndIsNotApplicableWithoutTheImu) {
+  const fs::path dir = workDir("time_offset_clean");
+  for (int seed : {1, 3}) {
+    const fs::path data = dir / ("data" + std::to_string(seed));
+    simulate(data, seed);
+    const fs::path out = dir / ("run" + std::to_string(seed));
+    run(data, out, "", "default.json");
+    const nlohmann::json d = diagnose(out, "--no-figures");
+    EXPECT_EQ(d["verdict"], "none") << "seed " << seed << ": " << d.dump(1);
+    bool tested = false;
+    for (const auto& e : d["ranking"])
+      if (e["effect"] == "time_offset") {
+        tested = true;
+        EXPECT_LT(e["score"].get<double>(), 1.0) << e.dump(1);
+      }
+    EXPECT_TRUE(tested) << d.dump(1);
+  }
+  auto notApplicable = [](const nlohmann::json& d) {
+    for (const auto& e : d["not_applicable"])
+      if (e["effect"] == "time_offset") return true;
+    return false;
+  };
+  run(dir / "data1", dir / "vo", "", "gs_vo.json");
+  EXPECT_TRUE(notApplicable(diagnose(dir / "vo", "--no-figures")));
+  run(dir / "data1", dir / "estimated", "--set imu.estimate_time_offset=true", "default.json");
+  EXPECT_TRUE(notApplicable(diagnose(dir / "estimated", "--no-figures")));
 }
 
 // Clean data, three seeds, gs_vo with and without affine brightness: verdict none.

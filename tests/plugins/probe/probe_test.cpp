@@ -92,7 +92,7 @@ const nlohmann::json kGlobalNoAffine = {{"shutter", {{"plugin", "shutter.global"
 
 std::map<std::string, ProbeResult> evaluateAll(const DiagnosticsLog& log, const nlohmann::json& cfg) {
   std::map<std::string, ProbeResult> out;
-  for (const char* name : kProbes) out[name] = test::makePlugin<DiagnosticProbe>(name)->evaluate(log, cfg);
+  for (const char* name : kProbes) out[name] = test::makePlugin<DiagnosticProbe>(name)->evaluate(ProbeInput{log, cfg});
   return out;
 }
 
@@ -145,7 +145,7 @@ TEST(Probes, AModelledEffectIsNotApplicable) {
   // A logged line delay also means the run modelled a rolling shutter.
   DiagnosticsLog l2 = syntheticLog(Effect::RollingShutter, 3);
   l2.line_delay_s = 30e-6;
-  EXPECT_FALSE(test::makePlugin<DiagnosticProbe>("probe.rolling_shutter")->evaluate(l2, kGlobalNoAffine).applicable);
+  EXPECT_FALSE(test::makePlugin<DiagnosticProbe>("probe.rolling_shutter")->evaluate(ProbeInput{l2, kGlobalNoAffine}).applicable);
 }
 
 TEST(Probes, AnEmptyLogIsTooLittleDataNotAVerdict) {

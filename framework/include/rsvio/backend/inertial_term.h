@@ -26,9 +26,13 @@
 
 #include "rsvio/backend/bundle_adjustment.h"
 #include "rsvio/imu/imu_factor.h"
+#include "rsvio/imu/visual_inertial_factor.h"
 #include "rsvio/lie/se3.h"
 
 namespace rsvio {
+
+// A keyframe's optimiser variables as the IMU factor reads them (pose T_Cf_Wf, v in W_m, both biases).
+VisualInertialKeyframe visualInertialStateOf(const Keyframe& k);
 
 struct InertialTermOptions {
   double imu_weight = 1.0;       // alpha of eq. 34

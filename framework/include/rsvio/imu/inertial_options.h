@@ -17,6 +17,9 @@ struct InertialOptions {
   double imu_weight = 1.0;              // alpha of eq. 34
   double twist_weight = 1.0;            // beta of eq. 34
   bool estimate_time_offset = false;    // camera-IMU time offset online (t_imu = t_cam + offset)
+  // Added to the calibration's time offset (what rsvio diagnose measures when the calibration lacks
+  // it); with estimate_time_offset the estimate starts there.
+  double time_offset_correction_ms = 0.0;
   // Visual-inertial initialisation (vi_init.h), tried at every new keyframe until it succeeds.
   int init_min_keyframes = 8;
   double init_min_duration_s = 1.5;
