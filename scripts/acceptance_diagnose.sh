@@ -7,13 +7,15 @@
 #
 #   scripts/acceptance_diagnose.sh [OUT]          (default out/acceptance_diagnose)
 #   EFFECTS="exposure vignetting" SEEDS="1 2 3" CLEAN_SEEDS="1 2 3 4 5" scripts/acceptance_diagnose.sh
+#   EFFECTS=time_offset CLEAN=clean_vio CLEAN_SEEDS="1 2 3" scripts/acceptance_diagnose.sh out/acc_toff
 #
 # Effects: rolling_shutter (rs.json, 58.94 us per row = 30 ms readout), exposure (exposure.json, +-1 stop
 # over 8 s, 0.05 stops jitter), vignetting (vignette.json, corner at half), response (response.json,
 # gamma 2.2). "ratio" is ATE before / after; it compares unequal spans when the before run failed.
-# time_offset needs the visual-inertial estimator and is not run yet.
-# The "before" model is configs/gs_vo.json; for exposure without affine brightness
-# (--set photometric.affine=null), since gs_vo already models it.
+# time_offset (time_offset.json: 15 ms) and clean_vio start from configs/default.json (visual-inertial,
+# offset not estimated): run them with EFFECTS="time_offset" CLEAN="clean_vio".
+# The "before" model is configs/gs_vo.json for the visual effects; for exposure without affine
+# brightness (--set photometric.affine=null), since gs_vo already models it.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${RSVIO_BIN:-$ROOT/build/bin/rsvio}"
@@ -33,9 +35,11 @@ simcfg() {
     exposure) echo "$CFG/sim/exposure.json" ;;
     vignetting) echo "$CFG/sim/vignette.json" ;;
     response) echo "$CFG/sim/response.json" ;;
-    clean|clean_noaffine) echo "$CFG/sim/gs.json" ;;
+    time_offset) echo "$CFG/sim/time_offset.json" ;;
+    clean|clean_noaffine|clean_vio) echo "$CFG/sim/gs.json" ;;
   esac
 }
+model() { case "$1" in time_offset|clean_vio) echo "$CFG/default.json" ;; *) echo "$CFG/gs_vo.json" ;; esac; }
 base_sets() { case "$1" in exposure|clean_noaffine) echo "--set photometric.affine=null" ;; esac; }
 
 field() {  # field JSON_FILE PYTHON_EXPR
@@ -61,7 +65,7 @@ one() {
     touch "$data/.complete"
   fi
   # shellcheck disable=SC2046
-  "$BIN" run --config "$CFG/gs_vo.json" --data "$data" --out "$d/before" $(base_sets "$effect") > "$d/before.log" 2>&1 || true
+  "$BIN" run --config "$(model "$effect")" --data "$data" --out "$d/before" $(base_sets "$effect") > "$d/before.log" 2>&1 || true
   "$BIN" diagnose --run "$d/before" --json > "$d/diagnose.json" 2> "$d/diagnose.err" || true
   local verdict line top ate_b ate_a="-" ratio="-" ev="-"
   verdict=$(field "$d/diagnose.json" "d['verdict']")
@@ -70,7 +74,7 @@ one() {
   if [ "$verdict" != none ]; then
     line=$(field "$d/diagnose.json" "d['config_line']")
     # shellcheck disable=SC2046,SC2086
-    "$BIN" run --config "$CFG/gs_vo.json" --data "$data" --out "$d/after" $(base_sets "$effect") $line > "$d/after.log" 2>&1 || true
+    "$BIN" run --config "$(model "$effect")" --data "$data" --out "$d/after" $(base_sets "$effect") $line > "$d/after.log" 2>&1 || true
     "$BIN" diagnose --run "$d/after" --against "$d/before" --json > "$d/against.json" 2>/dev/null || true
     ate_a=$(ate_of "$d/after/report.json")
     ratio=$(field "$d/against.json" "'%.2f' % d['against']['ate_ratio'] if 'ate_ratio' in d['against'] else '-'")
@@ -80,5 +84,6 @@ one() {
 }
 
 for e in $EFFECTS; do for s in $SEEDS; do one "$e" "$s"; done; done
-for s in $CLEAN_SEEDS; do one clean "$s"; one clean_noaffine "$s"; done
+CLEAN="${CLEAN:-clean clean_noaffine}"
+for s in $CLEAN_SEEDS; do for c in $CLEAN; do one "$c" "$s"; done; done
 echo "table: $TABLE (per case: $OUT/<effect>-<seed>/{before,after,diagnose.json,against.json})"

@@ -102,11 +102,13 @@ inline fs::path makeRun(const fs::path& dir, const RunSpec& spec) {
       r.ba = Eigen::Vector3d(0.01 * std::cos(0.05 * i), 0.02, -0.01);
       r.twist << 1.0, 0, 0, 0, 0, 0.05 * std::sin(0.1 * i);
       r.scale = 1.0 + 0.001 * i;
+      r.time_offset_ms = 15.0 * (1.0 - std::exp(-0.05 * i));  // estimated online, converging
       if (spec.vo_states) {
         r.v.setZero();
         r.bg.setZero();
         r.ba.setZero();
         r.scale = 1.0;
+        r.time_offset_ms = 0.0;
       }
       rows.push_back(r);
     }

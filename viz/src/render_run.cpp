@@ -76,6 +76,20 @@ std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool h
   tw.series = {trans, rot};
   tw.y_from_zero = true;
   if (!twist_zero) panels.push_back(std::move(tw));
+  // The camera-IMU time offset over time, when it moved (estimated online; constant when assumed).
+  bool offset_moves = false;
+  for (const auto& r : rows) offset_moves |= std::abs(r.time_offset_ms - rows.front().time_offset_ms) > 1e-6;
+  if (offset_moves) {
+    Panel to;
+    to.title = "Camera-IMU time offset (t_imu = t_cam + offset)";
+    to.y_label = "offset [ms]";
+    Series os{"", t, {}, Rgb{140, 86, 75}};
+    for (const auto& r : rows) os.y.push_back(r.time_offset_ms);
+    to.series = {os};
+    panels.push_back(std::move(to));
+  } else if (not_estimated) {
+    not_estimated->push_back("Time offset");
+  }
   if (!has_scale) {
     if (not_estimated) not_estimated->push_back("Scale");
     if (!panels.empty()) panels.back().x_label = "time since first keyframe [s]";

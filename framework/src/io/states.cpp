@@ -12,8 +12,9 @@ namespace rsvio {
 
 namespace {
 constexpr const char* kHeader =
-    "# t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale";
-constexpr int kColumns = 17;
+    "# t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale,time_offset_ms";
+constexpr int kColumns = 18;
+constexpr int kColumnsBeforeOffset = 17;  // files written before the time_offset_ms column
 }  // namespace
 
 void writeStates(const std::vector<StateRow>& rows, const std::string& path) {
@@ -31,6 +32,7 @@ void writeStates(const std::vector<StateRow>& rows, const std::string& path) {
     for (int i = 0; i < 3; ++i) put(r.ba[i]);
     for (int i = 0; i < 6; ++i) put(r.twist[i]);
     put(r.scale);
+    put(r.time_offset_ms);
     out << "\n";
   }
   }, "states");
@@ -49,12 +51,13 @@ std::vector<StateRow> readStates(const std::string& path) {
     std::stringstream ss(line);
     std::string cell;
     while (std::getline(ss, cell, ',')) f.push_back(cell);
-    if (static_cast<int>(f.size()) != kColumns)
+    const int cols = static_cast<int>(f.size());
+    if (cols != kColumns && cols != kColumnsBeforeOffset)
       throw DataError::at(path, n, "expected " + std::to_string(kColumns) + " columns, found " +
                                        std::to_string(f.size()));
     StateRow r;
-    double v[kColumns];
-    for (int i = 0; i < kColumns; ++i) {
+    double v[kColumns] = {};
+    for (int i = 0; i < cols; ++i) {
       char* end = nullptr;
       v[i] = std::strtod(f[i].c_str(), &end);
       if (end == f[i].c_str() || *end != '\0' || !std::isfinite(v[i]))
@@ -66,6 +69,7 @@ std::vector<StateRow> readStates(const std::string& path) {
     r.ba = Eigen::Vector3d(v[7], v[8], v[9]);
     for (int i = 0; i < 6; ++i) r.twist[i] = v[10 + i];
     r.scale = v[16];
+    r.time_offset_ms = v[17];  // 0 in a 17-column file
     rows.push_back(r);
   }
   return rows;

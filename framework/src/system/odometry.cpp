@@ -105,6 +105,7 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
       if (m->twistEnergySigma(&sigma_t, &sigma_r)) break;
     inertial = std::make_unique<InertialState>(io, sensors, rolling, sigma_t, sigma_r);
     window->setInertial(inertial.get());
+    record->setGlobals(&inertial->globals());
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
   }

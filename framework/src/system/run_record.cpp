@@ -24,7 +24,8 @@ io::StampedPose stamped(int64_t t_ns, const SE3d& T_c_w) {
 
 RunRecord::RunRecord(const CameraModel& camera, const RowTiming& timing, bool rolling, bool estimate_affine,
                      const CameraCalibration& calibration)
-    : camera_(camera), timing_(timing), rolling_(rolling), estimate_affine_(estimate_affine) {
+    : camera_(camera), timing_(timing), rolling_(rolling), estimate_affine_(estimate_affine),
+      time_offset_s_(calibration.time_offset_s) {
   diag_.width = calibration.width;
   diag_.height = calibration.height;
   diag_.line_delay_s = rolling ? timing.line_delay_s : 0.0;
@@ -65,6 +66,7 @@ void RunRecord::recordKeyframe(const Keyframe& kf) {
   r.frame_index = kf.frame_index;
   r.t_ns = kf.t_ns;
   r.state = kf.state;
+  r.time_offset_s = timeOffset();
   if (!rolling_ && kf.has_observed_twist) r.state.twist = kf.observed_twist;
 }
 
@@ -190,6 +192,7 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     s.v = r.state.v_wm;
     s.bg = r.state.bias_gyro;
     s.ba = r.state.bias_accel;
+    s.time_offset_ms = 1e3 * r.time_offset_s;
     rows[r.t_ns] = s;
   }
   for (const auto& kf : window) {
@@ -199,6 +202,7 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     s.v = kf->state.v_wm;
     s.bg = kf->state.bias_gyro;
     s.ba = kf->state.bias_accel;
+    s.time_offset_ms = 1e3 * timeOffset();
     rows[kf->t_ns] = s;
   }
   std::vector<StateRow> out;

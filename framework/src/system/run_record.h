@@ -56,6 +56,7 @@ struct KeyframeRecord {
   int64_t frame_index = 0;
   int64_t t_ns = 0;
   KeyframeState state;
+  double time_offset_s = 0.0;  // the camera-IMU time offset when the record was made (a global state)
 };
 
 class RunRecord : public WindowSink {
@@ -68,6 +69,10 @@ class RunRecord : public WindowSink {
   void addFrame(const FrameRecord& f) { frames_.push_back(f); }
   FrameRecord* frame(int64_t index);  // the record of that frame, or nullptr
   const std::vector<FrameRecord>& frames() const { return frames_; }
+
+  // The global states a keyframe's record also keeps (the time offset); without them, the
+  // calibration's offset.
+  void setGlobals(const GlobalStates* g) { globals_ = g; }
 
   // Keyframes: the current state of a keyframe (its twist: see the invariants).
   void recordKeyframe(const Keyframe& kf);
@@ -105,6 +110,9 @@ class RunRecord : public WindowSink {
   const RowTiming& timing_;
   bool rolling_ = false;
   bool estimate_affine_ = false;
+  double time_offset_s_ = 0.0;                   // the calibration's (assumed) offset
+  const GlobalStates* globals_ = nullptr;
+  double timeOffset() const { return globals_ ? globals_->state.time_offset_s : time_offset_s_; }
   std::vector<FrameRecord> frames_;
   std::map<int64_t, KeyframeRecord> keyframes_;  // by kf_id, every keyframe of the run
   std::vector<MapPoint> map_points_;             // points that left the window (marginalised)

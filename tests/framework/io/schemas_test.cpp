@@ -87,6 +87,7 @@ TEST(StatesSchema, RoundTripAndBadLine) {
   a.ba = {0.01, 0.02, 0.03};
   a.twist << 0.5, 0.1, -0.1, 0.2, 0.3, -0.4;
   a.scale = 2.5;
+  a.time_offset_ms = 14.75;
   const auto path = tmpFile("states.csv");
   writeStates({a, a}, path);
   auto rows = readStates(path);
@@ -94,9 +95,15 @@ TEST(StatesSchema, RoundTripAndBadLine) {
   EXPECT_EQ(rows[0].t_ns, a.t_ns);
   EXPECT_NEAR((rows[0].twist - a.twist).norm(), 0, 1e-8);
   EXPECT_DOUBLE_EQ(rows[1].scale, 2.5);
+  EXPECT_DOUBLE_EQ(rows[1].time_offset_ms, 14.75);
+  // A file written before the time_offset_ms column (17 columns) still reads, with offset 0.
+  std::ofstream(path, std::ios::app) << "12,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1\n";
+  rows = readStates(path);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_DOUBLE_EQ(rows[2].time_offset_ms, 0.0);
   std::ofstream(path, std::ios::app) << "12,1,2\n";
   const auto msg = errorOf([&] { readStates(path); });
-  EXPECT_NE(msg.find(path + ":4: expected 17 columns, found 3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(path + ":5: expected 18 columns, found 3"), std::string::npos) << msg;
   fs::remove(path);
 }
 

@@ -1,8 +1,11 @@
 // states.csv: one row per keyframe after its last optimisation (user-contract.md).
-//   # t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale
+//   # t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale,time_offset_ms
 // v: IMU velocity in the metric world [m/s] (0 without an IMU); bg [rad/s], ba [m/s^2]: biases;
 // xi: the keyframe's camera twist per second (translation; rotation), translation in W_f units per s;
-// scale: metres per W_f unit (1 without an IMU).
+// scale: metres per W_f unit (1 without an IMU), the final one;
+// time_offset_ms: the camera-IMU time offset (t_imu = t_cam + offset) when the keyframe was last
+// optimised, so an online estimate shows over time (the assumed value when it is not estimated).
+// readStates also reads the 17-column files written before the offset column.
 #pragma once
 #include <Eigen/Core>
 #include <cstdint>
@@ -18,6 +21,7 @@ struct StateRow {
   Eigen::Vector3d ba = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
   double scale = 1.0;
+  double time_offset_ms = 0.0;
 };
 
 void writeStates(const std::vector<StateRow>& rows, const std::string& path);
