@@ -76,33 +76,28 @@ std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool h
   tw.series = {trans, rot};
   tw.y_from_zero = true;
   if (!twist_zero) panels.push_back(std::move(tw));
+  // One series over time of a scalar state.
+  auto scalar = [&](const char* title, const char* ylabel, Rgb colour, double StateRow::*field) {
+    Panel p;
+    p.title = title;
+    p.y_label = ylabel;
+    Series s{"", t, {}, colour};
+    for (const auto& r : rows) s.y.push_back(r.*field);
+    p.series = {s};
+    panels.push_back(std::move(p));
+  };
   // The camera-IMU time offset over time, when it moved (estimated online; constant when assumed).
   bool offset_moves = false;
   for (const auto& r : rows) offset_moves |= std::abs(r.time_offset_ms - rows.front().time_offset_ms) > 1e-6;
-  if (offset_moves) {
-    Panel to;
-    to.title = "Camera-IMU time offset (t_imu = t_cam + offset)";
-    to.y_label = "offset [ms]";
-    Series os{"", t, {}, Rgb{140, 86, 75}};
-    for (const auto& r : rows) os.y.push_back(r.time_offset_ms);
-    to.series = {os};
-    panels.push_back(std::move(to));
-  } else if (not_estimated) {
+  if (offset_moves)
+    scalar("Camera-IMU time offset (t_imu = t_cam + offset)", "offset [ms]", Rgb{140, 86, 75}, &StateRow::time_offset_ms);
+  else if (not_estimated)
     not_estimated->push_back("Time offset");
-  }
-  if (!has_scale) {
-    if (not_estimated) not_estimated->push_back("Scale");
-    if (!panels.empty()) panels.back().x_label = "time since first keyframe [s]";
-    return panels;
-  }
-  Panel sc;
-  sc.title = "Scale (metres per visual unit)";
-  sc.y_label = "scale";
-  sc.x_label = "time since first keyframe [s]";
-  Series ss{"", t, {}, Rgb{148, 103, 189}};
-  for (const auto& r : rows) ss.y.push_back(r.scale);
-  sc.series = {ss};
-  panels.push_back(std::move(sc));
+  if (has_scale)
+    scalar("Scale (metres per visual unit)", "scale", Rgb{148, 103, 189}, &StateRow::scale);
+  else if (not_estimated)
+    not_estimated->push_back("Scale");
+  if (!panels.empty()) panels.back().x_label = "time since first keyframe [s]";
   return panels;
 }
 
