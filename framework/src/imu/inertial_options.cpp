@@ -36,6 +36,13 @@ ParamTable inertialParamTable() {
       paramDouble("init_max_accel_bias_m_s2", d.init_max_accel_bias_m_s2, 0.0, 1e3, "m/s^2",
                   "refuse an initialisation whose accelerometer bias exceeds this (the keyframe poses do not "
                   "fit the IMU yet; tried again at the next keyframe)"),
+      paramDouble("init_min_interval_s", d.init_min_interval_s, 0.0, 1e3, "s",
+                  "the initialisation solves on keyframes at least this far apart (picked back from the newest; "
+                  "0: every keyframe): noisy keyframe poses bias its scale low over short intervals"),
+      paramDouble("init_max_imu_chi2", d.init_max_imu_chi2, 0.0, 1e300, "",
+                  "refuse an initialisation whose IMU factors at its solution (poses held) have a mean whitened "
+                  "energy above this (the keyframe poses do not fit the IMU; tried again at the next keyframe); "
+                  "0: no test"),
       paramDouble("repreintegrate_gyro_bias_rad_s", d.repreintegrate_gyro_bias_rad_s, 0.0, 10.0, "rad/s",
                   "re-preintegrate an IMU factor when the gyro bias moved further from its linearisation"),
       paramDouble("repreintegrate_accel_bias_m_s2", d.repreintegrate_accel_bias_m_s2, 0.0, 100.0, "m/s^2",
@@ -68,6 +75,8 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.accel_bias_prior_sigma_m_s2 = p.getDouble("accel_bias_prior_sigma_m_s2");
   o.init_max_gyro_bias_rad_s = p.getDouble("init_max_gyro_bias_rad_s");
   o.init_max_accel_bias_m_s2 = p.getDouble("init_max_accel_bias_m_s2");
+  o.init_min_interval_s = p.getDouble("init_min_interval_s");
+  o.init_max_imu_chi2 = p.getDouble("init_max_imu_chi2");
   o.repreintegrate_gyro_bias_rad_s = p.getDouble("repreintegrate_gyro_bias_rad_s");
   o.repreintegrate_accel_bias_m_s2 = p.getDouble("repreintegrate_accel_bias_m_s2");
   o.fail_max_gyro_bias_rad_s = p.getDouble("fail_max_gyro_bias_rad_s");

@@ -181,11 +181,81 @@ void refineNonlinear(const std::vector<ImuPreintegration>& pre, const std::vecto
   }
 }
 
+// Whitened IMU factor energy per interval at the result (poses fixed, one bias for all keyframes).
+void measureFit(const std::vector<ImuPreintegration>& pre, const std::vector<ViInitKeyframe>& kfs,
+                const SE3d& T_cm_i, double offset, ViInitResult* res) {
+  double sum = 0.0, mx = 0.0;
+  for (size_t k = 0; k + 1 < kfs.size(); ++k) {
+    const ImuFactor f(pre[k]);
+    const VisualInertialKeyframe ki{kfs[k].T_cf_wf, res->velocities_wm[k], res->bias};
+    const VisualInertialKeyframe kj{kfs[k + 1].T_cf_wf, res->velocities_wm[k + 1], res->bias};
+    const double e = (f.sqrtInformation() * visualInertialResidual(f, ki, kj, res->T_wm_wf, T_cm_i, offset)).squaredNorm();
+    sum += e;
+    mx = std::max(mx, e);
+  }
+  res->imu_chi2_mean = pre.empty() ? 0.0 : sum / static_cast<double>(pre.size());
+  res->imu_chi2_max = mx;
+}
+
+}  // namespace
+
+namespace {
+ViInitResult solveInit(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& imu, const ImuNoise& noise,
+                       const SE3d& T_cm_i, double offset, const ViInitOptions& opt);
 }  // namespace
 
 ViInitResult initializeVisualInertial(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& imu,
                                       const ImuNoise& noise, const SE3d& T_cm_i, double offset,
                                       const ViInitOptions& opt) {
+  if (!(opt.min_interval_s > 0.0) || kfs.size() < 2) return solveInit(kfs, imu, noise, T_cm_i, offset, opt);
+  const int n = static_cast<int>(kfs.size());
+  const double duration = nsToS(kfs.back().t_ns - kfs.front().t_ns);
+  if (n < opt.min_keyframes || duration < opt.min_duration_s) return solveInit(kfs, imu, noise, T_cm_i, offset, opt);
+  // Pick back from the newest keyframe, each at least min_interval_s before the last one picked.
+  std::vector<int> picked{n - 1};
+  for (int k = n - 2; k >= 0; --k)
+    if (nsToS(kfs[picked.back()].t_ns - kfs[k].t_ns) >= opt.min_interval_s - 1e-9) picked.push_back(k);
+  std::reverse(picked.begin(), picked.end());
+  if (static_cast<int>(picked.size()) < opt.min_subset_keyframes) {
+    ViInitResult res;
+    res.duration_s = duration;
+    res.status = fmt("waiting for data: %.0f keyframes at least min_interval_s %.2f s apart over %.2f s, need %.0f",
+                     picked.size(), opt.min_interval_s, duration, opt.min_subset_keyframes);
+    return res;
+  }
+  std::vector<ViInitKeyframe> sub;
+  for (int k : picked) sub.push_back(kfs[k]);
+  ViInitOptions so = opt;
+  so.min_keyframes = std::min(opt.min_keyframes, opt.min_subset_keyframes);
+  ViInitResult r = solveInit(sub, imu, noise, T_cm_i, offset, so);
+  r.duration_s = duration;
+  if (!r.success) return r;
+  // Every keyframe's velocity from the nearest picked one (earlier if any), through the IMU.
+  const std::vector<Vec3> v_sub = r.velocities_wm;
+  r.velocities_wm.assign(n, Vec3::Zero());
+  const Vec3 g_wm(0.0, 0.0, -kGravityNorm);
+  const Mat3 R_ci = T_cm_i.rotationMatrix();
+  size_t p = 0;
+  for (int k = 0; k < n; ++k) {
+    while (p + 1 < picked.size() && picked[p + 1] <= k) ++p;
+    const int a = picked[p];
+    if (a == k) {
+      r.velocities_wm[k] = v_sub[p];
+      continue;
+    }
+    const int i = std::min(a, k), j = std::max(a, k);  // propagate over [t_i, t_j], forwards or backwards
+    const ImuPreintegration pre = ImuPreintegration::fromBuffer(imu, kfs[i].t_ns, kfs[j].t_ns, noise, r.bias, offset);
+    const ImuPreintegration::Delta d = pre.corrected(r.bias);
+    const Mat3 R_wm_i = (r.T_wm_wf.so3() * SO3d(kfs[i].T_cf_wf.so3().inverse().matrix() * R_ci)).matrix();
+    const Vec3 dv = g_wm * pre.dt() + R_wm_i * d.v;
+    r.velocities_wm[k] = a == i ? Vec3(v_sub[p] + dv) : Vec3(v_sub[p] - dv);
+  }
+  return r;
+}
+
+namespace {
+ViInitResult solveInit(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& imu, const ImuNoise& noise,
+                       const SE3d& T_cm_i, double offset, const ViInitOptions& opt) {
   ViInitResult res;
   const int n = static_cast<int>(kfs.size());
   res.duration_s = n > 1 ? nsToS(kfs.back().t_ns - kfs.front().t_ns) : 0.0;
@@ -274,6 +344,7 @@ ViInitResult initializeVisualInertial(const std::vector<ViInitKeyframe>& kfs, co
 
   // Step 4: non-linear refinement on the full IMU factors.
   if (opt.refine_nonlinear) refineNonlinear(pre, kfs, T_cm_i, offset, opt, &res);
+  measureFit(pre, kfs, T_cm_i, offset, &res);
   if (!(res.T_wm_wf.scale() > 0.0)) {
     res.status = "rejected: refinement produced a non-positive scale";
     return res;
@@ -286,5 +357,7 @@ ViInitResult initializeVisualInertial(const std::vector<ViInitKeyframe>& kfs, co
                    res.T_wm_wf.scale(), res.accel_excitation_m_s2, res.relative_singular_value, tilt_deg);
   return res;
 }
+
+}  // namespace
 
 }  // namespace rsvio

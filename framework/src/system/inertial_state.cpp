@@ -115,6 +115,7 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
   vo.min_accel_excitation_m_s2 = o_.init_min_accel_excitation_m_s2;
   vo.max_gravity_norm_error = o_.init_max_gravity_norm_error;
   vo.accel_bias_prior_sigma_m_s2 = o_.accel_bias_prior_sigma_m_s2;
+  vo.min_interval_s = o_.init_min_interval_s;
   const ViInitResult r = initializeVisualInertial(kfs, buffer_, sensors_.imu, T_cm_i_, globals_.state.time_offset_s, vo);
   if (!r.success) {
     status_ = r.status;
@@ -125,6 +126,14 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
     os << "initialisation refused: biases |b_g| " << r.bias.gyro.norm() << " rad/s, |b_a| " << r.bias.accel.norm()
        << " m/s^2 above imu.init_max_gyro_bias_rad_s " << o_.init_max_gyro_bias_rad_s
        << " / imu.init_max_accel_bias_m_s2 " << o_.init_max_accel_bias_m_s2
+       << " (the keyframe poses do not fit the IMU yet)";
+    status_ = os.str();
+    return false;
+  }
+  if (o_.init_max_imu_chi2 > 0.0 && !(r.imu_chi2_mean <= o_.init_max_imu_chi2)) {
+    std::ostringstream os;
+    os << "initialisation refused: mean whitened IMU factor energy " << r.imu_chi2_mean << " at its solution (scale "
+       << r.T_wm_wf.scale() << ") above imu.init_max_imu_chi2 " << o_.init_max_imu_chi2
        << " (the keyframe poses do not fit the IMU yet)";
     status_ = os.str();
     return false;

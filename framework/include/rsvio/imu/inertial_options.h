@@ -30,6 +30,13 @@ struct InertialOptions {
   // e.g. the monocular start's early drift) and tried again at the next keyframe.
   double init_max_gyro_bias_rad_s = 0.05;
   double init_max_accel_bias_m_s2 = 0.5;
+  // > 0: the initialisation solves on keyframes at least this far apart (ViInitOptions::min_interval_s).
+  double init_min_interval_s = 0.0;
+  // > 0: refuse an initialisation whose IMU factors, at its own solution with the keyframe poses held,
+  // have a mean whitened energy above this (ViInitResult::imu_chi2_mean): the keyframe poses do not fit
+  // the IMU (the rolling-shutter monocular start's distorted first keyframes, docs/vio.md); tried again
+  // at the next keyframe. 0: no test.
+  double init_max_imu_chi2 = 0.0;
   // Re-preintegrate an IMU factor when the bias moved further than this from its linearisation.
   double repreintegrate_gyro_bias_rad_s = 0.01;
   double repreintegrate_accel_bias_m_s2 = 0.1;

@@ -47,6 +47,14 @@ struct ViInitOptions {
   int nonlinear_iterations = 8;
   double accel_bias_prior_sigma_m_s2 = 0.1;  // zero-mean prior on b_a in the refinement
   ImuBias initial_bias;                      // preintegration starts from it
+  // > 0: solve on a subset of the keyframes at least this far apart in time (picked back from the
+  // newest), the others' velocities propagated by the IMU from the nearest one picked. The linear
+  // system compares accelerations, i.e. second differences of the keyframe positions over the
+  // interval: pose noise enters them divided by dt^2 and, being in the regressor, biases the scale
+  // low (errors in variables). Rolling-shutter keyframe poses are noisy enough for that to matter
+  // (docs/vio.md); 0: every keyframe (consecutive intervals).
+  double min_interval_s = 0.0;
+  int min_subset_keyframes = 4;  // with min_interval_s > 0: fewer picked keyframes wait for data
 };
 
 struct ViInitKeyframe {
@@ -65,6 +73,9 @@ struct ViInitResult {
   double accel_excitation_m_s2 = 0.0;
   double relative_singular_value = 0.0;
   double gravity_norm_linear_m_s2 = 0.0;
+  // Whitened IMU factor energy of the result per interval (mean and largest; poses held, one bias).
+  double imu_chi2_mean = 0.0;
+  double imu_chi2_max = 0.0;
 };
 
 ViInitResult initializeVisualInertial(const std::vector<ViInitKeyframe>& keyframes, const ImuBuffer& imu,
