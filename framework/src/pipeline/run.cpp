@@ -247,7 +247,7 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   const size_t n = source->numFrames();
   const double rate = sensors.camera.rate_hz > 0 ? sensors.camera.rate_hz : 20.0;
   // IMU samples up to half a frame past the frame's time on the IMU clock (more is harmless).
-  const double offset_s = sensors.camera.time_offset_s + 1e-3 * inertialOptionsFromConfig(cfg).time_offset_correction_ms;
+  const double offset_s = inertialOptionsFromConfig(cfg).assumedTimeOffsetS(sensors.camera);
   const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(std::abs(offset_s));
   auto last_print = Clock::now();
   long processed = 0;

@@ -31,7 +31,7 @@ std::unique_ptr<I> makeSlot(PluginHost& host, const nlohmann::json& cfg, const s
 Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSetup& s) : config(cfg), sensors(s) {
   const InertialOptions io = inertialOptionsFromConfig(cfg);
   // The offset every part uses (t_imu = t_cam + offset): the calibration's plus imu.time_offset_correction_ms.
-  sensors.camera.time_offset_s += 1e-3 * io.time_offset_correction_ms;
+  sensors.camera.time_offset_s = io.assumedTimeOffsetS(s.camera);
   seed = static_cast<uint64_t>(cfg.value("seed", 0L));
   threads = std::clamp(static_cast<int>(cfg.value("threads", 1L)), 1, 2);
   for (const char* slot : {"camera", "shutter", "solver"})

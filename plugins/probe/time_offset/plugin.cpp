@@ -24,6 +24,7 @@
 #include <sstream>
 
 #include "../common/probe_common.h"
+#include "rsvio/imu/inertial_options.h"
 #include "rsvio/io/trajectory.h"
 #include "rsvio/plugin/plugin_api.h"
 
@@ -114,10 +115,9 @@ class TimeOffsetProbe : public DiagnosticProbe {
     // What the run assumed: the calibration's offset plus imu.time_offset_correction_ms of the run's own
     // config. A camera-frame trajectory is on the camera clock: to the IMU clock with that offset, and
     // R_W_B = R_W_C R_C_B. (A body-frame one is on the IMU clock with the run's final offset.)
-    const nlohmann::json& own = in.run_config ? *in.run_config : cfg;
-    const double correction_ms =
-        own.contains("imu") && own["imu"].is_object() ? own["imu"].value("time_offset_correction_ms", 0.0) : 0.0;
-    const double assumed = in.sensors->camera.time_offset_s + 1e-3 * correction_ms;
+    const InertialOptions own = inertialOptionsFromConfig(in.run_config ? *in.run_config : cfg);
+    const double correction_ms = own.time_offset_correction_ms;
+    const double assumed = own.assumedTimeOffsetS(in.sensors->camera);
     const double clock_shift = camera ? assumed : 0.0;
     const Eigen::Quaterniond q_c_b(in.sensors->camera.T_B_C.rotation().transpose());
     const GyroSignal gyro(*in.imu);

@@ -8,6 +8,7 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
+#include "rsvio/core/types.h"
 #include "rsvio/plugin/plugin.h"
 
 namespace rsvio {
@@ -48,6 +49,11 @@ struct InertialOptions {
   double fail_grace_s = 2.0;            // the residual test starts this long after the initialisation
 
   static InertialOptions fromParams(const Params& p);
+  // The camera-IMU time offset a run assumes (t_imu = t_cam + offset) [s]: the calibration's plus
+  // time_offset_correction_ms. The one place that sum is made (estimator, IMU feed, probe.time_offset).
+  double assumedTimeOffsetS(const CameraCalibration& c) const {
+    return c.time_offset_s + 1e-3 * time_offset_correction_ms;
+  }
 };
 
 ParamTable inertialParamTable();
