@@ -28,6 +28,7 @@ struct ObsLin {
   ObsState state = ObsState::kOob;
   float energy = 0.f;
   GeoJac Jg;
+  Eigen::Vector2d Jl = Eigen::Vector2d::Zero();  // d uv / d line delay (filled when it is estimated)
   Mat66 M;
   Vec6d g;
   float u = 0.f, v = 0.f, grad_u = 0.f, grad_v = 0.f, mean_r = 0.f, mean_w = 0.f;
@@ -52,6 +53,7 @@ struct ObsRef {
 struct Linearization {
   std::vector<ObsLin> obs;              // per ObsRef
   std::vector<double> Hpp, bp;          // per point (undamped)
+  std::vector<double> hpl;              // per point: d^2 E / d rho d line_delay (when it is estimated)
   std::vector<int> blk_begin, blk_count;  // per point: involved blocks in the arena
   std::vector<int> blk_ids;             // window indices (host first)
   std::vector<double> hpc;              // kfDim values per arena entry: d^2 E / d rho d x_block
@@ -67,6 +69,10 @@ struct Linearization {
 struct ChunkSums {
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
+  // The line delay's row (when it is estimated): its coupling to the photometric dimensions, its own
+  // entry and its gradient.
+  Eigen::VectorXd Hl;
+  double Hll = 0.0, bl = 0.0;
   double energy = 0.0, energy_in = 0.0;
   int num_in = 0, num_oob = 0, num_outlier = 0;
 };
@@ -88,6 +94,8 @@ struct BundleAdjuster::Impl {
   std::vector<uint8_t> fixed;           // per camera dimension
   int nc = 0;                           // camera dimensions: all keyframe and global states
   int nkd = 0;                          // photometric dimensions (the leading nkd of nc), coupled to points
+  int gl = -1;                          // the line delay's dimension in nc when it is estimated, else -1
+  RowTiming timing;                     // the row timing of this linearisation (line delay from the globals)
   // Linearisations: current (accepted) and trial.
   Linearization cur, trial;
   std::vector<ChunkSums> chunks;

@@ -21,6 +21,7 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
   const int kd = cfg.layout.kfDim();
   m.nkd = nk * kd;
   m.nc = cfg.layout.windowDim(nk);
+  m.gl = cfg.layout.lineDelay() ? cfg.layout.globalOffset(nk) + cfg.layout.lineDelayIndex() : -1;
   if (only) {
     std::vector<ActivePoint*> copy = *only;  // `only` may be m.points itself (BundleAdjuster::points())
     m.points.swap(copy);
@@ -55,6 +56,7 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
       for (int i = 0; i < 8; ++i) f[i] = 1;
     if (!cfg.estimate_affine) f[StateLayout::kAffine] = f[StateLayout::kAffine + 1] = 1;
   }
+  if (m.gl >= 0 && nk < cfg.line_delay_min_keyframes) m.fixed[static_cast<size_t>(m.gl)] = 1;
   // The yaw of T_Wm_Wf about gravity is unobservable (visual_inertial_factor.h): held.
   if (cfg.layout.inertial) m.fixed[static_cast<size_t>(cfg.layout.globalOffset(nk) + StateLayout::kGlobalRot + 2)] = 1;
   // Arena of per-point blocks: host + one per observation at most.
@@ -62,6 +64,7 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
     L->obs.resize(m.obs_refs.size());
     L->Hpp.assign(m.points.size(), 0.0);
     L->bp.assign(m.points.size(), 0.0);
+    L->hpl.assign(m.points.size(), 0.0);
     L->blk_begin.resize(m.points.size());
     L->blk_count.assign(m.points.size(), 0);
     int total = 0;
@@ -73,9 +76,10 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
     L->hpc.resize(static_cast<size_t>(total) * kd);
   }
   m.chunks.resize(kPointChunks);
-  for (ChunkSums& c : m.chunks) {  // points couple to the photometric blocks only
+  for (ChunkSums& c : m.chunks) {  // points couple to the photometric blocks (and the line delay)
     c.H.resize(m.nkd, m.nkd);
     c.b.resize(m.nkd);
+    c.Hl.resize(m.nkd);
   }
 }
 
@@ -257,6 +261,7 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
     if (rolling) {
       ol.Jg.block<2, 6>(0, kColHostTwist) = pr.d_uv_d_xi_h;
       ol.Jg.block<2, 6>(0, kColTargetTwist) = pr.d_uv_d_xi;
+      if (m.gl >= 0) ol.Jl = pr.d_uv_d_line_delay;
     } else {
       ol.Jg.block<2, 6>(0, kColHostTwist).setZero();
       ol.Jg.block<2, 6>(0, kColTargetTwist).setZero();
@@ -264,8 +269,10 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   }
 }
 
-// Accumulates the points of one chunk: their Schur data and the camera blocks.
-template <int KD>
+// Accumulates the points of one chunk: their Schur data and the camera blocks. LD: the line delay is
+// estimated, one more geometric column (after the inverse depth) whose row goes to ChunkSums::Hl, Hll,
+// bl and, for the inverse depth, to Linearization::hpl.
+template <int KD, bool LD>
 void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   // Per observation, Hl = Jl^T M Jl over the N = 2 KD + 1 coordinates (host block, target block,
   // inverse depth) is formed compactly: only NG geometric columns (poses, twists when rolling, inverse
@@ -273,11 +280,14 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   //   H_gg = G^T M_uu G, H_ga = G^T M_ua, H_aa = M_aa   (G: 2 x NG)
   // and then scattered into the chunk's blocks (about 5x fewer products than the dense 6 x N form).
   constexpr int N = 2 * KD + 1;
-  constexpr int NG = KD == 14 ? 25 : 13;
+  constexpr int NG0 = KD == 14 ? 25 : 13;  // poses, twists, inverse depth (index NG0 - 1)
+  constexpr int NG = NG0 + (LD ? 1 : 0);  // and the line delay (index NG0)
   using GM = Eigen::Matrix<double, 2, NG>;
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
   cs.H.setZero();
   cs.b.setZero();
+  cs.Hl.setZero();
+  cs.Hll = cs.bl = 0.0;
   cs.energy = cs.energy_in = 0.0;
   cs.num_in = cs.num_oob = cs.num_outlier = 0;
   const int np = static_cast<int>(m.points.size());
@@ -295,6 +305,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       for (int i = 0; i < 6; ++i, ++k) gidx[k] = KD + StateLayout::kTwist + i, gsrc[k] = kColTargetTwist + i;
     gidx[k] = 2 * KD, gsrc[k] = kColIdepth;
   }
+  constexpr int ID = NG0 - 1;  // the inverse depth's compact column
   const int aidx[4] = {StateLayout::kAffine, StateLayout::kAffine + 1, KD + StateLayout::kAffine,
                        KD + StateLayout::kAffine + 1};
   GM G;
@@ -305,7 +316,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   for (int i = begin; i < end; ++i) {
     const ActivePoint& p = *m.points[static_cast<size_t>(i)];
     const int hb = p.host->index;
-    double Hpp = 0.0, bp = 0.0;
+    double Hpp = 0.0, bp = 0.0, hpl = 0.0;
     const int ab = L.blk_begin[static_cast<size_t>(i)];
     int nb = 1;
     L.blk_ids[static_cast<size_t>(ab)] = hb;
@@ -320,7 +331,8 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       ++cs.num_in;
       cs.energy_in += ol.energy;
       const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
-      for (int k = 0; k < NG; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
+      for (int k = 0; k < NG0; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
+      if constexpr (LD) G.col(NG0) = ol.Jl;
       MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G);
       Hgg.noalias() = G.transpose().lazyProduct(MG);
       Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
@@ -335,23 +347,30 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       const Eigen::Index ld = cs.H.rows();
       auto at = [&](int x, int y) -> double& { return Hd[static_cast<Eigen::Index>(row[y]) * ld + row[x]]; };
       double hcol[N];  // column 2 KD of the local Hessian: d^2 E / d rho d x
-      for (int a = 0; a < NG - 1; ++a) {
+      for (int a = 0; a < ID; ++a) {
         const int ga = gidx[a];
-        for (int c = 0; c < NG - 1; ++c) at(ga, gidx[c]) += Hgg(a, c);
+        for (int c = 0; c < ID; ++c) at(ga, gidx[c]) += Hgg(a, c);
         for (int c = 0; c < 4; ++c) {
           at(ga, aidx[c]) += Hga(a, c);
           at(aidx[c], ga) += Hga(a, c);
         }
-        hcol[ga] = Hgg(a, NG - 1);
+        hcol[ga] = Hgg(a, ID);
         cs.b[row[ga]] += bg[a];
+        if constexpr (LD) cs.Hl[row[ga]] += Hgg(a, NG0);
       }
       for (int a = 0; a < 4; ++a) {
         for (int c = 0; c < 4; ++c) at(aidx[a], aidx[c]) += ol.M(2 + a, 2 + c);
-        hcol[aidx[a]] = Hga(NG - 1, a);
+        hcol[aidx[a]] = Hga(ID, a);
         cs.b[row[aidx[a]]] += -ol.g[2 + a];
+        if constexpr (LD) cs.Hl[row[aidx[a]]] += Hga(NG0, a);
       }
-      Hpp += Hgg(NG - 1, NG - 1);
-      bp += bg[NG - 1];
+      Hpp += Hgg(ID, ID);
+      bp += bg[ID];
+      if constexpr (LD) {
+        cs.Hll += Hgg(NG0, NG0);
+        cs.bl += bg[NG0];
+        hpl += Hgg(ID, NG0);
+      }
       h_host += Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol);
       L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
       Eigen::Map<Eigen::Matrix<double, KD, 1>>(L.hpc.data() + static_cast<size_t>(ab + nb) * KD) =
@@ -360,6 +379,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
     }
     L.Hpp[static_cast<size_t>(i)] = Hpp;
     L.bp[static_cast<size_t>(i)] = bp;
+    L.hpl[static_cast<size_t>(i)] = hpl;
     L.blk_count[static_cast<size_t>(i)] = nb;
   }
 }
@@ -369,12 +389,17 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
 void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
                           const CameraModel& camera, const RowTiming& timing) {
   const ResidualKernel kernel(cfg.residual);
+  // The line delay being estimated is the globals' (the given timing's otherwise).
+  m.timing = timing;
+  if (m.gl >= 0 && m.globals) m.timing.line_delay_s = m.globals->state.line_delay_s;
   m.runner->run(static_cast<int>(m.pairs.size()),
-                [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, timing, kernel); });
-  if (cfg.layout.rolling) {
-    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14>(m, L, c); });
+                [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, m.timing, kernel); });
+  if (m.gl >= 0) {
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, true>(m, L, c); });
+  } else if (cfg.layout.rolling) {
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, false>(m, L, c); });
   } else {
-    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<8>(m, L, c); });
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<8, false>(m, L, c); });
   }
   L.Hcc.setZero(m.nc, m.nc);
   L.bc.setZero(m.nc);
@@ -383,6 +408,12 @@ void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundl
   for (const ChunkSums& c : m.chunks) {  // fixed order: deterministic
     L.Hcc.topLeftCorner(m.nkd, m.nkd) += c.H;
     L.bc.head(m.nkd) += c.b;
+    if (m.gl >= 0) {
+      L.Hcc.col(m.gl).head(m.nkd) += c.Hl;
+      L.Hcc.row(m.gl).head(m.nkd) += c.Hl.transpose();
+      L.Hcc(m.gl, m.gl) += c.Hll;
+      L.bc[m.gl] += c.bl;
+    }
     L.energy_photo += c.energy;
     L.energy_photo_in += c.energy_in;
     L.num_in += c.num_in;

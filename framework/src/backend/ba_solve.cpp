@@ -46,15 +46,32 @@ void dampAndMask(const BundleAdjuster::Impl& m, const Linearization& L, double l
   }
 }
 
+// H, b minus the chunks' Schur sums (photometric blocks and the line delay's row).
+void subtractSchur(const BundleAdjuster::Impl& m, Eigen::MatrixXd& H, Eigen::VectorXd& b) {
+  for (const ChunkSums& c : m.chunks) {
+    H.topLeftCorner(m.nkd, m.nkd) -= c.H;
+    b.head(m.nkd) -= c.b;
+    if (m.gl >= 0) {
+      H.col(m.gl).head(m.nkd) -= c.Hl;
+      H.row(m.gl).head(m.nkd) -= c.Hl.transpose();
+      H(m.gl, m.gl) -= c.Hll;
+      b[m.gl] -= c.bl;
+    }
+  }
+}
+
 template <int KD>
 void schurChunk(BundleAdjuster::Impl& m, const Linearization& L, double lambda, const std::vector<double>& keep,
                 int chunk) {
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
   cs.H.setZero();
   cs.b.setZero();
+  cs.Hl.setZero();
+  cs.Hll = cs.bl = 0.0;
   const int np = static_cast<int>(m.points.size());
   const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
   const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+  const double keep_l = m.gl >= 0 ? keep[static_cast<size_t>(m.gl)] : 0.0;
   using V = Eigen::Matrix<double, KD, 1>;
   V hm[64];
   for (int i = begin; i < end; ++i) {
@@ -77,6 +94,15 @@ void schurChunk(BundleAdjuster::Impl& m, const Linearization& L, double lambda, 
         cs.H.template block<KD, KD>(ia * KD, ic * KD).noalias() += (hm[a] * inv) * hm[c].transpose();
       }
     }
+    if (m.gl >= 0) {  // the line delay's row of the point's Schur complement
+      const double hl = L.hpl[static_cast<size_t>(i)] * keep_l;
+      for (int a = 0; a < nb; ++a) {
+        const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
+        cs.Hl.template segment<KD>(ia * KD) += hm[a] * (hl * inv);
+      }
+      cs.Hll += hl * hl * inv;
+      cs.bl += hl * bp * inv;
+    }
   }
 }
 
@@ -88,6 +114,7 @@ void backSubstitute(const BundleAdjuster::Impl& m, const Linearization& L, doubl
     const double Hpp = L.Hpp[i] * (1.0 + lambda);
     if (!(Hpp > kMinHpp)) continue;
     double r = L.bp[i];
+    if (m.gl >= 0) r -= L.hpl[i] * keep[static_cast<size_t>(m.gl)] * dx_c[m.gl];
     const int ab = L.blk_begin[i];
     for (int a = 0; a < L.blk_count[i]; ++a) {
       const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
@@ -110,16 +137,14 @@ bool solveSchur(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdj
   } else {
     m.runner->run(kPointChunks, [&](int c) { schurChunk<8>(m, L, lambda, keep, c); });
   }
-  for (const ChunkSums& c : m.chunks) {
-    H.topLeftCorner(m.nkd, m.nkd) -= c.H;
-    b.head(m.nkd) -= c.b;
-  }
+  subtractSchur(m, H, b);
   // Jacobi scaling: the inertial blocks bring information up to ~1e11 (a gyro bias over 0.1 s) beside
   // twists with ~1e-6; solving D H D y = D b, dx = D y (D = diag(H)^-1/2) is the same step in exact
   // arithmetic and keeps the dense factorisation accurate.
-  // Visual-inertial layouts only (visual odometry keeps its unscaled, bit-identical steps).
+  // The line delay (s per row, information ~1e12) needs it as much. Visual-inertial layouts and an
+  // estimated line delay only (visual odometry keeps its unscaled, bit-identical steps).
   Eigen::VectorXd D = Eigen::VectorXd::Ones(H.rows());
-  if (cfg.layout.inertial)
+  if (cfg.layout.inertial || m.gl >= 0)
     for (Eigen::Index i = 0; i < D.size(); ++i) D[i] = H(i, i) > 0.0 ? 1.0 / std::sqrt(H(i, i)) : 1.0;
   H = D.asDiagonal() * H * D.asDiagonal();
   b = D.cwiseProduct(b);
@@ -155,6 +180,13 @@ void fullSparse(const BundleAdjuster::Impl& m, const Linearization& L, int kd, d
     }
     trip.emplace_back(row, row, Hpp);
     rhs[row] = L.bp[static_cast<size_t>(p)];
+    if (m.gl >= 0) {
+      const double v = L.hpl[static_cast<size_t>(p)] * keep[static_cast<size_t>(m.gl)];
+      if (v != 0.0) {
+        trip.emplace_back(m.gl, row, v);
+        trip.emplace_back(row, m.gl, v);
+      }
+    }
     const int ab = L.blk_begin[static_cast<size_t>(p)];
     for (int a = 0; a < L.blk_count[static_cast<size_t>(p)]; ++a) {
       const int ia = L.blk_ids[static_cast<size_t>(ab + a)];
@@ -177,11 +209,21 @@ bool solveFull(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdju
   Eigen::VectorXd rhs, x;
   std::vector<double> keep;
   fullSparse(m, L, cfg.layout.kfDim(), lambda, S, rhs, keep);
+  // The same Jacobi scaling as solveSchur's, for the same layouts.
+  const bool scale = cfg.layout.inertial || m.gl >= 0;
+  Eigen::VectorXd D;
+  if (scale) {
+    D = S.diagonal();
+    for (Eigen::Index i = 0; i < D.size(); ++i) D[i] = D[i] > 0.0 ? 1.0 / std::sqrt(D[i]) : 1.0;
+    S = D.asDiagonal() * S * D.asDiagonal();
+    rhs = D.cwiseProduct(rhs);
+  }
   SolverStats st;
   if (!solver.solveSparse(S, rhs, x, &st)) {
     if (message) *message = st.message;
     return false;
   }
+  if (scale) x = D.cwiseProduct(x);
   dx_c = x.head(m.nc);
   dx_p = x.tail(static_cast<Eigen::Index>(m.points.size()));
   return true;
@@ -339,7 +381,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       else
         applyStep(kf->state, dx_c.segment(kf->index * kd, kd), config_.layout);
     }
-    if (m.globals && config_.layout.inertial) {
+    if (m.globals && config_.layout.globalDim() > 0) {
       m.globals->backup = m.globals->state;
       applyGlobalStep(m.globals->state, dx_c.segment(config_.layout.globalOffset(nk), config_.layout.globalDim()),
                       config_.layout);
@@ -362,7 +404,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       if (rel < config_.step_threshold) break;
     } else {
       for (auto& kf : window) kf->state = kf->backup;
-      if (m.globals && config_.layout.inertial) m.globals->state = m.globals->backup;
+      if (m.globals && config_.layout.globalDim() > 0) m.globals->state = m.globals->backup;
       for (size_t i = 0; i < m.points.size(); ++i) m.points[i]->idepth = idepth_backup[i];
       lambda *= 4.0;
     }
@@ -435,10 +477,7 @@ void BundleAdjuster::pointsTerm(const KeyframeList& window, const std::vector<Ac
   }
   Hf = m.cur.Hcc;
   bf = m.cur.bc;
-  for (const ba::ChunkSums& c : m.chunks) {
-    Hf.topLeftCorner(m.nkd, m.nkd) -= c.H;
-    bf.head(m.nkd) -= c.b;
-  }
+  ba::subtractSchur(m, Hf, bf);
   for (int i = 0; i < m.nc; ++i) {
     if (keep[static_cast<size_t>(i)] != 0.0) continue;
     Hf.row(i).setZero();
@@ -450,14 +489,20 @@ void BundleAdjuster::pointsTerm(const KeyframeList& window, const std::vector<Ac
   std::vector<int> blk;
   for (int k = 0; k < static_cast<int>(window.size()); ++k)
     if (Hf.block(k * kd, 0, kd, m.nc).cwiseAbs().maxCoeff() > 0.0) blk.push_back(k);
-  const Eigen::Index n = static_cast<Eigen::Index>(blk.size()) * kd;
+  // Rows of the term: the blocks' photometric rows, then (line delay estimated) the global block, whose
+  // only entry the points reach is the line delay.
+  std::vector<Eigen::Index> rows;
+  for (int k : blk)
+    for (int r = 0; r < kd; ++r) rows.push_back(static_cast<Eigen::Index>(k) * kd + r);
+  const int g = config_.layout.lineDelay() ? config_.layout.globalDim() : 0;
+  const int g0 = config_.layout.globalOffset(static_cast<int>(window.size()));
+  for (int r = 0; r < g; ++r) rows.push_back(g0 + r);
+  const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
   H->resize(n, n);
   b->resize(n);
-  for (size_t i = 0; i < blk.size(); ++i) {
-    b->segment(static_cast<Eigen::Index>(i) * kd, kd) = bf.segment(blk[i] * kd, kd);
-    for (size_t j = 0; j < blk.size(); ++j)
-      H->block(static_cast<Eigen::Index>(i) * kd, static_cast<Eigen::Index>(j) * kd, kd, kd) =
-          Hf.block(blk[i] * kd, blk[j] * kd, kd, kd);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    (*b)[i] = bf[rows[static_cast<size_t>(i)]];
+    for (Eigen::Index j = 0; j < n; ++j) (*H)(i, j) = Hf(rows[static_cast<size_t>(i)], rows[static_cast<size_t>(j)]);
   }
   *blocks = blk;
 }

@@ -42,13 +42,19 @@ void MarginalizationPrior::setLayout(const StateLayout& layout) {
     layout_ = layout;
     return;
   }
-  if (layout_.inertial) throw Error("MarginalizationPrior::setLayout: only the inertial state can join");
+  if (layout_.inertial || layout.lineDelay() != layout_.lineDelay())
+    throw Error("MarginalizationPrior::setLayout: only the inertial state can join");
   const int kd = layout_.kfDim();
   const Eigen::Index nb = static_cast<Eigen::Index>(keyframes_.size());
-  // Each block grows by the (empty) inertial block after its photometric part, then the global block.
+  // Each block grows by the (empty) inertial block after its photometric part, then the global block
+  // by its (empty) inertial part in front of the line delay when the prior has that already.
   for (Eigen::Index i = nb - 1; i >= 0; --i) insertZeros(H_, b_, i * kd + kd, StateLayout::kImuDim);
-  insertZeros(H_, b_, H_.rows(), layout.globalDim());
+  insertZeros(H_, b_, std::min<Eigen::Index>(nb * layout.stateDim(), H_.rows()), layout.inertialGlobalDim());
   layout_ = layout;
+  if (globals_ && globals_->in_prior) {  // no information on the new entries yet: any point is exact
+    globals_->lin.T_wm_wf = globals_->state.T_wm_wf;
+    globals_->lin.time_offset_s = globals_->state.time_offset_s;
+  }
 }
 
 void MarginalizationPrior::addKeyframe(Keyframe* kf) {
@@ -63,7 +69,7 @@ void MarginalizationPrior::addKeyframe(Keyframe* kf) {
 void MarginalizationPrior::ensureGlobalBlock() {
   const Eigen::Index want = static_cast<Eigen::Index>(keyframes_.size()) * layout_.stateDim() + layout_.globalDim();
   if (H_.rows() < want) insertZeros(H_, b_, H_.rows(), want - H_.rows());
-  if (layout_.inertial && globals_ && !globals_->in_prior) {
+  if (layout_.globalDim() > 0 && globals_ && !globals_->in_prior) {
     globals_->in_prior = true;
     globals_->lin = globals_->state;  // first estimate, frozen from now on
   }
@@ -89,9 +95,10 @@ void MarginalizationPrior::addTerm(const std::vector<Keyframe*>& kfs, const Eige
   const int td = static_cast<int>((H_t.rows() - g) / nk);  // the term's block size per keyframe
   const int kd = layout_.kfDim(), d = layout_.stateDim();
   if (td != kd && td != d) throw Error("MarginalizationPrior::addTerm: term size does not match its keyframes");
-  if (with_global && !layout_.inertial) throw Error("MarginalizationPrior::addTerm: no global block without the IMU");
+  if (with_global && layout_.globalDim() == 0)
+    throw Error("MarginalizationPrior::addTerm: the layout has no global block");
   for (Keyframe* kf : kfs) addKeyframe(kf);
-  if (with_global || layout_.inertial) ensureGlobalBlock();
+  if (with_global || layout_.globalDim() > 0) ensureGlobalBlock();
   // Prior index of each of the term's rows.
   std::vector<Eigen::Index> idx(static_cast<size_t>(H_t.rows()));
   for (Eigen::Index i = 0; i < nk; ++i) {
@@ -113,10 +120,13 @@ void MarginalizationPrior::addTerm(const std::vector<Keyframe*>& kfs, const Eige
 }
 
 void MarginalizationPrior::addScaleFreeTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t,
-                                            const Eigen::VectorXd& b_t, bool project_scale) {
+                                            const Eigen::VectorXd& b_t, bool project_scale, bool with_global) {
   const int d = layout_.kfDim();
-  if (!project_scale || H_t.rows() != static_cast<Eigen::Index>(kfs.size()) * d) return addTerm(kfs, H_t, b_t);
+  const Eigen::Index g = with_global ? layout_.globalDim() : 0;
+  if (!project_scale || H_t.rows() != static_cast<Eigen::Index>(kfs.size()) * d + g)
+    return addTerm(kfs, H_t, b_t, with_global);
   for (Keyframe* kf : kfs) addKeyframe(kf);  // freezes x_lin of keyframes new to the prior
+  // The global rows (the line delay: the scale does not change it) have no component along the scale.
   Eigen::VectorXd n = Eigen::VectorXd::Zero(H_t.rows());
   for (size_t i = 0; i < kfs.size(); ++i) {
     const Eigen::Index o = static_cast<Eigen::Index>(i) * d;
@@ -124,13 +134,13 @@ void MarginalizationPrior::addScaleFreeTerm(const std::vector<Keyframe*>& kfs, c
     if (layout_.rolling) n.segment<3>(o + StateLayout::kTwist) = kfs[i]->lin.twist.head<3>();
   }
   const double nn = n.squaredNorm();
-  if (!(nn > 0.0)) return addTerm(kfs, H_t, b_t);
+  if (!(nn > 0.0)) return addTerm(kfs, H_t, b_t, with_global);
   const Eigen::VectorXd u = n / std::sqrt(nn);
   const Eigen::VectorXd Hu = H_t * u;
   const double uHu = u.dot(Hu);
   const Eigen::MatrixXd H_p = H_t - u * Hu.transpose() - Hu * u.transpose() + uHu * (u * u.transpose());
   const Eigen::VectorXd b_p = b_t - u * u.dot(b_t);
-  addTerm(kfs, H_p, b_p);
+  addTerm(kfs, H_p, b_p, with_global);
 }
 
 void MarginalizationPrior::marginalizeKeyframe(Keyframe* kf) {

@@ -33,16 +33,20 @@ void applyStep(KeyframeState& x, const Eigen::Ref<const Eigen::VectorXd>& step, 
 
 Eigen::VectorXd globalDelta(const GlobalState& x, const GlobalState& lin, const StateLayout& layout) {
   Eigen::VectorXd d(layout.globalDim());
-  if (!layout.inertial) return d;
-  d.head<4>() = (x.T_wm_wf * lin.T_wm_wf.inverse()).log();
-  if (layout.estimate_time_offset) d[StateLayout::kGlobalOffset] = x.time_offset_s - lin.time_offset_s;
+  if (layout.inertial) {
+    d.head<4>() = (x.T_wm_wf * lin.T_wm_wf.inverse()).log();
+    if (layout.estimate_time_offset) d[StateLayout::kGlobalOffset] = x.time_offset_s - lin.time_offset_s;
+  }
+  if (layout.lineDelay()) d[layout.lineDelayIndex()] = x.line_delay_s - lin.line_delay_s;
   return d;
 }
 
 void applyGlobalStep(GlobalState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout) {
-  if (!layout.inertial) return;
-  x.T_wm_wf = RxSO3d::exp(step.head<4>()) * x.T_wm_wf;
-  if (layout.estimate_time_offset) x.time_offset_s += step[StateLayout::kGlobalOffset];
+  if (layout.inertial) {
+    x.T_wm_wf = RxSO3d::exp(step.head<4>()) * x.T_wm_wf;
+    if (layout.estimate_time_offset) x.time_offset_s += step[StateLayout::kGlobalOffset];
+  }
+  if (layout.lineDelay()) x.line_delay_s += step[layout.lineDelayIndex()];
 }
 
 Eigen::VectorXd gatherState(const Eigen::VectorXd& x_win, int k, int n, const StateLayout& layout) {

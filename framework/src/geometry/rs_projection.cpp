@@ -12,7 +12,7 @@ namespace rsvio {
 RowTiming RowTiming::from(const ShutterModel& shutter, const CameraModel& camera) {
   const double y0 = camera.calibration().rowZero();
   if (!shutter.isRolling()) return global(y0);
-  return rolling(y0, shutter.lineDelay(), shutter.rowTimeDerivative() >= 0.0);
+  return rolling(y0, shutter.lineDelay(), !std::signbit(shutter.rowTimeDerivative()));  // -0.0: bottom_up
 }
 
 namespace {

@@ -12,9 +12,11 @@ namespace rsvio {
 
 namespace {
 constexpr const char* kHeader =
-    "# t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale,time_offset_ms";
-constexpr int kColumns = 18;
-constexpr int kColumnsBeforeOffset = 17;  // files written before the time_offset_ms column
+    "# t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale,time_offset_ms,"
+    "line_delay_us";
+constexpr int kColumns = 19;
+constexpr int kColumnsBeforeLineDelay = 18;  // files written before the line_delay_us column
+constexpr int kColumnsBeforeOffset = 17;     // files written before the time_offset_ms column
 }  // namespace
 
 void writeStates(const std::vector<StateRow>& rows, const std::string& path) {
@@ -33,6 +35,7 @@ void writeStates(const std::vector<StateRow>& rows, const std::string& path) {
     for (int i = 0; i < 6; ++i) put(r.twist[i]);
     put(r.scale);
     put(r.time_offset_ms);
+    put(r.line_delay_us);
     out << "\n";
   }
   }, "states");
@@ -52,7 +55,7 @@ std::vector<StateRow> readStates(const std::string& path) {
     std::string cell;
     while (std::getline(ss, cell, ',')) f.push_back(cell);
     const int cols = static_cast<int>(f.size());
-    if (cols != kColumns && cols != kColumnsBeforeOffset)
+    if (cols != kColumns && cols != kColumnsBeforeLineDelay && cols != kColumnsBeforeOffset)
       throw DataError::at(path, n, "expected " + std::to_string(kColumns) + " columns, found " +
                                        std::to_string(f.size()));
     StateRow r;
@@ -70,6 +73,7 @@ std::vector<StateRow> readStates(const std::string& path) {
     for (int i = 0; i < 6; ++i) r.twist[i] = v[10 + i];
     r.scale = v[16];
     r.time_offset_ms = v[17];  // 0 in a 17-column file
+    r.line_delay_us = v[18];   // 0 in files before the column
     rows.push_back(r);
   }
   return rows;

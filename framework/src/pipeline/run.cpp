@@ -322,6 +322,7 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
                                 vio["status"].get<std::string>() + "): the outputs are visual odometry, "
                                 "camera poses without metric scale");
   }
+  if (const nlohmann::json sh = odo.shutterReport(); !sh.is_null()) report.extra["shutter"] = sh;
   for (const auto& w : odo.warnings()) report.warnings.push_back(w);
 
   writeOutputs(odo, request.out_dir, streams, report.warnings);

@@ -18,14 +18,15 @@ constexpr double kRepreintegrateOffsetS = 1e-3; // re-preintegrate when the offs
 }  // namespace
 
 InertialState::InertialState(const InertialOptions& o, const SensorSetup& sensors, bool rolling,
-                             double twist_sigma_trans_m_s, double twist_sigma_rot_rad_s)
+                             double twist_sigma_trans_m_s, double twist_sigma_rot_rad_s, GlobalStates& globals)
     : o_(o),
       sensors_(sensors),
       rolling_(rolling),
       twist_sigma_t_(twist_sigma_trans_m_s),
       twist_sigma_r_(twist_sigma_rot_rad_s),
       T_cm_i_(cameraFromImu(sensors.camera.T_B_C)),
-      buffer_(5'000'000) {
+      buffer_(5'000'000),
+      globals_(globals) {
   globals_.state.time_offset_s = sensors.camera.time_offset_s;
   InertialTermOptions to;
   to.imu_weight = o.imu_weight;

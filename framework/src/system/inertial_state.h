@@ -35,8 +35,10 @@ namespace rsvio {
 class InertialState {
  public:
   // twist_sigma_*: the IMU twist energy's Sigma (MotionPrior::twistEnergySigma); <= 0: no twist energy.
+  // globals: the window's global states (KeyframeWindow::globals()), which hold T_Wm_Wf and the time
+  // offset beside an estimated line delay; they must outlive this.
   InertialState(const InertialOptions& o, const SensorSetup& sensors, bool rolling, double twist_sigma_trans_m_s,
-                double twist_sigma_rot_rad_s);
+                double twist_sigma_rot_rad_s, GlobalStates& globals);
 
   bool enabled() const { return o_.enabled; }
   bool initialised() const { return initialised_; }
@@ -88,7 +90,7 @@ class InertialState {
   double twist_sigma_t_ = 0.0, twist_sigma_r_ = 0.0;
   SE3d T_cm_i_;
   ImuBuffer buffer_;
-  GlobalStates globals_;
+  GlobalStates& globals_;
   std::unique_ptr<InertialTerm> term_;
   bool initialised_ = false;
   double scale_init_ = 1.0;

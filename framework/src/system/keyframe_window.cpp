@@ -60,6 +60,11 @@ KeyframeWindow::KeyframeWindow(const WindowSetup& setup, const CameraModel& came
   }
   updateTerms();
   prior_ = std::make_unique<MarginalizationPrior>(setup.ba.layout);
+  globals_.state.line_delay_s = timing_.line_delay_s;
+  if (setup.ba.layout.globalDim() > 0) {
+    ba_->setGlobals(&globals_);
+    prior_->setGlobals(&globals_);
+  }
   min_act_dist_ = bo_.activation_min_dist_px;
 }
 
@@ -97,7 +102,13 @@ bool KeyframeWindow::initializeInertial(const std::vector<ViInitKeyframe>& keyfr
   return true;
 }
 
-void KeyframeWindow::optimize(int max_iterations) { last_ba_ = ba_->optimize(window_, *prior_, max_iterations); }
+void KeyframeWindow::optimize(int max_iterations) {
+  last_ba_ = ba_->optimize(window_, *prior_, max_iterations);
+  if (ba_->config().layout.lineDelay() && timing_.line_delay_s != globals_.state.line_delay_s) {
+    timing_.line_delay_s = globals_.state.line_delay_s;
+    tracer_->setTiming(timing_);
+  }
+}
 
 void KeyframeWindow::evaluate() { ba_->evaluate(window_, *prior_); }
 
@@ -338,7 +349,7 @@ void KeyframeWindow::removeOutliersAndMarginalizePoints(Keyframe& newest, Window
     if (!blocks.empty()) {
       std::vector<Keyframe*> kfs;
       for (int k : blocks) kfs.push_back(window_[static_cast<size_t>(k)].get());
-      prior_->addScaleFreeTerm(kfs, H, b, bo_.marg_project_scale);
+      prior_->addScaleFreeTerm(kfs, H, b, bo_.marg_project_scale, ba_->config().layout.lineDelay());
     }
     for (ActivePoint* p : to_marg) {
       for (const ActiveObservation& o : p->obs)

@@ -66,7 +66,8 @@ struct WindowSetup {
 
 class KeyframeWindow {
  public:
-  // camera, timing and solver must outlive the window.
+  // camera and solver must outlive the window; timing is the shutter's (its line delay the start when
+  // the layout estimates it).
   KeyframeWindow(const WindowSetup& setup, const CameraModel& camera, const RowTiming& timing,
                  SolverBackend& solver);
   KeyframeWindow(const KeyframeWindow&) = delete;
@@ -113,6 +114,11 @@ class KeyframeWindow {
   std::string divergence(std::string* warning);
 
   const BundleAdjustmentStats& lastStats() const { return last_ba_; }
+  // The window's global states (line delay, and T_Wm_Wf and the time offset once visual-inertial) and
+  // the row timing with the current line delay (updated by optimize() when it is estimated).
+  GlobalStates& globals() { return globals_; }
+  const GlobalStates& globals() const { return globals_; }
+  const RowTiming& timing() const { return timing_; }
 
   // Visual-inertial runs: the inertial part whose terms leave with the keyframes (may be null).
   void setInertial(InertialState* inertial) { inertial_ = inertial; }
@@ -132,7 +138,8 @@ class KeyframeWindow {
   uint64_t seed_ = 0;
   bool rolling_ = false;
   const CameraModel& camera_;
-  const RowTiming& timing_;
+  RowTiming timing_;
+  GlobalStates globals_;
   std::unique_ptr<CandidateTracer> tracer_;
   std::unique_ptr<BundleAdjuster> ba_;
   std::unique_ptr<SmoothMotionTerm> smooth_motion_;  // rolling shutter with a smooth-motion prior, else null

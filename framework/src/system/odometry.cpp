@@ -69,6 +69,8 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
       bc.affine_prior_b = p->affinePriorB();
     }
   bc.layout.rolling = rolling;
+  bc.layout.estimate_line_delay = rolling && shutter->estimatesLineDelay();
+  line_delay_start_s = timing.line_delay_s;
   bc.residual = fo.residual;
   bc.estimate_affine = estimate_affine;
   bc.lambda_initial = bo.lambda_initial;
@@ -103,9 +105,9 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
     double sigma_t = 0.0, sigma_r = 0.0;  // the IMU twist energy's Sigma, from the motion prior that has one
     for (const auto& m : motion)
       if (m->twistEnergySigma(&sigma_t, &sigma_r)) break;
-    inertial = std::make_unique<InertialState>(io, sensors, rolling, sigma_t, sigma_r);
+    inertial = std::make_unique<InertialState>(io, sensors, rolling, sigma_t, sigma_r, window->globals());
     window->setInertial(inertial.get());
-    record->setGlobals(&inertial->globals());
+    record->setGlobals(&window->globals());
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
   }
@@ -259,6 +261,7 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
     ScopedStage st(record->stages(), "optimise");
     window->optimize(bo.max_iterations);
   }
+  syncLineDelay();
   if (inertial) inertial->refreshFactors(window->mutableKeyframes());
   for (const auto& k : window->keyframes()) record->recordKeyframe(*k);
   if (FrameRecord* f = record->frame(frame_index)) {
@@ -284,12 +287,29 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
   checkDivergence();
 }
 
+void Odometry::Impl::syncLineDelay() {
+  if (!rolling || !shutter->estimatesLineDelay()) return;
+  const double ld = window->timing().line_delay_s;
+  if (ld == timing.line_delay_s) return;
+  timing.line_delay_s = ld;
+  tracking->setTiming(timing);
+}
+
 void Odometry::Impl::checkDivergence() {
   if (failed || window->size() < 2) return;
   std::string warning;
   std::string reason = window->divergence(&warning);
   if (!warning.empty()) record->addWarning(warning);
   if (reason.empty() && inertial) reason = inertial->checkDivergence(window->keyframes());
+  if (reason.empty() && rolling && shutter->estimatesLineDelay()) {
+    // An estimated readout longer than 0.2 s (or not finite) is no camera's: the estimate ran away.
+    const double readout_s = timing.line_delay_s * sensors.camera.height;
+    if (!std::isfinite(readout_s) || std::abs(readout_s) > 0.2) {
+      std::ostringstream os;
+      os << "line delay diverged: the estimated readout is " << readout_s * 1e3 << " ms (|readout| > 200 ms)";
+      reason = os.str();
+    }
+  }
   if (!reason.empty()) fail(reason);
 }
 
@@ -399,6 +419,7 @@ void Odometry::Impl::finish() {
   if (!failed && window->size() >= 2) {
     ScopedStage st(record->stages(), "optimise");
     window->optimize(bo.max_iterations);
+    syncLineDelay();
   }
   window->evaluate();
   for (const auto& kf : window->keyframes()) record->recordFinal(*kf);
@@ -466,6 +487,17 @@ nlohmann::json Odometry::inertialReport() const {
   }
   j["time_offset_estimated"] = m.inertial->options().estimate_time_offset;
   j["time_offset_ms"] = m.inertial->timeOffset() * 1e3;
+  return j;
+}
+nlohmann::json Odometry::shutterReport() const {
+  const Impl& m = *impl_;
+  if (!m.rolling) return nullptr;
+  nlohmann::json j;
+  const double rows = static_cast<double>(m.sensors.camera.height);
+  j["line_delay_estimated"] = m.shutter->estimatesLineDelay();
+  j["line_delay_us"] = m.timing.line_delay_s * 1e6;
+  j["readout_ms"] = m.timing.line_delay_s * rows * 1e3;
+  if (m.shutter->estimatesLineDelay()) j["line_delay_us_start"] = m.line_delay_start_s * 1e6;
   return j;
 }
 std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }

@@ -54,7 +54,8 @@ struct Odometry::Impl {
   std::vector<std::unique_ptr<PhotometricModel>> photometric;
   std::vector<const PhotometricModel*> photometric_ptrs;
   std::vector<std::unique_ptr<MotionPrior>> motion;
-  RowTiming timing;
+  RowTiming timing;             // the shutter's; its line delay follows the window's when estimated
+  double line_delay_start_s = 0.0;
   bool rolling = false;
   bool estimate_affine = false;
   // The parts.
@@ -76,6 +77,8 @@ struct Odometry::Impl {
   void makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms, std::shared_ptr<const ImagePyramid> pyr,
                     const SE3d& T_c_w, const AffineBrightness& affine);
   void checkDivergence();
+  // An estimated line delay: the window's current value to the timing the tracker and record use.
+  void syncLineDelay();
   void tryInertialInitialisation();
   void fillInertial(int64_t t_ns);   // the history entry of t_ns gets its inertial fields (VIO)
   io::Trajectory toBody(io::Trajectory t) const;

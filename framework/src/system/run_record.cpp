@@ -67,6 +67,8 @@ void RunRecord::recordKeyframe(const Keyframe& kf) {
   r.t_ns = kf.t_ns;
   r.state = kf.state;
   r.time_offset_s = timeOffset();
+  r.line_delay_s = rolling_ ? timing_.line_delay_s : 0.0;
+  if (rolling_) diag_.line_delay_s = timing_.line_delay_s;  // the log's header: the latest estimate
   if (!rolling_ && kf.has_observed_twist) r.state.twist = kf.observed_twist;
 }
 
@@ -193,6 +195,7 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     s.bg = r.state.bias_gyro;
     s.ba = r.state.bias_accel;
     s.time_offset_ms = 1e3 * r.time_offset_s;
+    s.line_delay_us = 1e6 * r.line_delay_s;
     rows[r.t_ns] = s;
   }
   for (const auto& kf : window) {
@@ -203,6 +206,7 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     s.bg = kf->state.bias_gyro;
     s.ba = kf->state.bias_accel;
     s.time_offset_ms = 1e3 * timeOffset();
+    s.line_delay_us = rolling_ ? 1e6 * timing_.line_delay_s : 0.0;
     rows[kf->t_ns] = s;
   }
   std::vector<StateRow> out;

@@ -57,6 +57,7 @@ struct KeyframeRecord {
   int64_t t_ns = 0;
   KeyframeState state;
   double time_offset_s = 0.0;  // the camera-IMU time offset when the record was made (a global state)
+  double line_delay_s = 0.0;   // the line delay then (rolling shutter; it may be estimated online)
 };
 
 class RunRecord : public WindowSink {

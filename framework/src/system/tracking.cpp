@@ -25,6 +25,8 @@ TrackResult Tracking::trackFrom(const ImagePyramid& pyr, const TrackingFrame& in
   return tracker_->track(pyr, info, guesses);
 }
 
+void Tracking::setTiming(const RowTiming& timing) { tracker_->setTiming(timing); }
+
 void Tracking::setReference(const TrackingReference& reference) {
   tracker_->setReference(reference);
   first_rmse_ = std::nan("");

@@ -38,6 +38,8 @@ class Tracking {
   // Tracks a frame from given guesses; counters and history untouched (frames of the monocular start).
   TrackResult trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses);
   void setReference(const TrackingReference& reference);
+  // A new line delay (estimated online); takes effect with the next setReference().
+  void setTiming(const RowTiming& timing);
   void resetFirstRmse() { first_rmse_ = std::nan(""); }
   int lostInRow() const { return lost_in_row_; }
   double firstRmse() const { return first_rmse_; }

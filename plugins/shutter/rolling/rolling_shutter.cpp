@@ -3,7 +3,8 @@
 //
 // Calibration files rarely know the line delay (it is a hidden effect the user discovers), so the
 // param line_delay_us wins over the calibration's line_delay_s; with neither positive the plugin
-// refuses to start instead of running as a global shutter in disguise.
+// refuses to start instead of running as a global shutter in disguise, unless estimate_line_delay
+// asks the estimator to find it online (then that value, or 0, is where the estimate starts).
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -23,11 +24,14 @@ ParamTable rollingParams();  // the parameter table, below
 class RollingShutter : public ShutterModel {
  public:
   explicit RollingShutter(const Params& p)
-      : param_line_delay_us_(p.getDouble("line_delay_us")), param_readout_(p.getString("readout")) {}
+      : param_line_delay_us_(p.getDouble("line_delay_us")),
+        param_readout_(p.getString("readout")),
+        estimate_(p.getBool("estimate_line_delay")) {}
 
   void setCalibration(const CameraCalibration& calib) override {
     double ld = param_line_delay_us_ > 0.0 ? param_line_delay_us_ * 1e-6 : calib.line_delay_s;
-    if (!(ld > 0.0) || !std::isfinite(ld)) {
+    if (estimate_ && !(ld > 0.0)) ld = 0.0;  // the estimate starts from 0
+    if (!std::isfinite(ld) || (!estimate_ && !(ld > 0.0))) {
       std::string msg = std::string(kName) + " needs line_delay_us: the calibration has no line delay; give it with "
                         "--set shutter.params.line_delay_us=<microseconds per row> (readout time / image rows)";
       // When the plugin can estimate it, say so too (tests/apps/cli/newcomer_test.cpp holds this).
@@ -59,9 +63,10 @@ class RollingShutter : public ShutterModel {
   }
   double rowTimeDerivative() const override {
     requireCalibration();
-    return sign_ * line_delay_s_;
+    return sign_ * line_delay_s_;  // -0.0 for a zero delay read bottom_up (shutter.h)
   }
   double lineDelay() const override { return line_delay_s_; }
+  bool estimatesLineDelay() const override { return estimate_; }
   void setLineDelay(double line_delay_s) override {
     if (!(line_delay_s >= 0.0) || !std::isfinite(line_delay_s)) {
       std::ostringstream os;
@@ -78,6 +83,7 @@ class RollingShutter : public ShutterModel {
 
   double param_line_delay_us_;
   std::string param_readout_;
+  bool estimate_ = false;
   double y0_ = 0.0;
   double sign_ = 1.0;
   double line_delay_s_ = 0.0;
@@ -88,7 +94,10 @@ ParamTable rollingParams() {
   return {paramDouble("line_delay_us", 0.0, 0.0, 1e5, "us",
                       "time between two consecutive rows; 0 = the calibration's line_delay_s"),
           paramEnum("readout", "calibration", {"calibration", "top_down", "bottom_up"},
-                    "readout direction; calibration = the calibration's readout")};
+                    "readout direction; calibration = the calibration's readout"),
+          paramBool("estimate_line_delay", false,
+                    "estimate the line delay online in the window, starting from line_delay_us (or the "
+                    "calibration's, or 0); the estimate goes to states.csv and report.json")};
 }
 
 void registerAll(PluginRegistrar& r) {

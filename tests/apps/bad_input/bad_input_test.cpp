@@ -102,7 +102,7 @@ std::string tum(int n, double t0 = 100.0, bool header = true) {
 void writeValidRun(const fs::path& run) {
   writeText(run / "trajectory.tum", tum(12));
   writeText(run / "keyframes.tum", tum(4));
-  writeText(run / "states.csv", "# t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale,time_offset_ms\n");
+  writeText(run / "states.csv", "# t_ns,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,xi_tx,xi_ty,xi_tz,xi_rx,xi_ry,xi_rz,scale,time_offset_ms,line_delay_us\n");
   writeText(run / "points.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                                 "property float z\nproperty float intensity\nend_header\n0 0 1 100\n");
   writeText(run / "config.json", "{}\n");

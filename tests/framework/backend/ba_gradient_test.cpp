@@ -12,6 +12,10 @@
 // wrong or missing Jacobian term is an error of order 100 %. Shown once: the target twist Jacobian
 // zeroed fails both rolling-shutter tests (29 entries); the host pose Jacobian scaled by 0.8 fails all
 // four (45 entries).
+// With the line delay estimated (a global state, the window's last camera dimension) its gradient is
+// held to the exact identity with the twists' (below) and to its numeric difference. Shown once: its
+// Jacobian (ObsLin::Jl) zeroed fails both tests here and the three LineDelay tests
+// (line_delay_test.cpp); scaled by 0.8 it fails both tests here (the identity).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,7 +53,7 @@ int blockType(int i) {
 // small difference of large per-target terms and each block can be held to its own keyframe's scale
 // (with targets on both sides a host's gradient nearly cancels: measured host rotation -1.5e5
 // analytic vs -3.4e4 numeric out of per-target terms of 1.4e7, i.e. the ~1 % image-gradient error).
-void checkGradient(bool rolling, bool single_target = false) {
+void checkGradient(bool rolling, bool single_target = false, bool line_delay_estimated = false) {
   const double line_delay = rolling ? 30e-3 / 256 : 0.0;
   test::TestWindow w(3, rolling, line_delay, 1.0, 0.05);
   blurWindow(w, 3.0);
@@ -64,6 +68,8 @@ void checkGradient(bool rolling, bool single_target = false) {
   auto solver = test::makePlugin<SolverBackend>("solver.dense");
   BundleAdjustmentConfig cfg;
   cfg.layout.rolling = rolling;
+  cfg.layout.estimate_line_delay = line_delay_estimated;
+  cfg.line_delay_min_keyframes = 3;
   cfg.twist_regularization = 0.0;
   cfg.residual.huber_th = 1e4;
   cfg.residual.grad_weight_c = 1e6;
@@ -73,6 +79,9 @@ void checkGradient(bool rolling, bool single_target = false) {
   cfg.residual.outlier_th = 60.0;
   BundleAdjuster ba(cfg, w.camera, w.timing, *solver);
   MarginalizationPrior prior(cfg.layout);
+  GlobalStates globals;  // the estimated line delay, at the images' own (the other states are off)
+  globals.state.line_delay_s = line_delay;
+  if (line_delay_estimated) ba.setGlobals(&globals);
   // Away from the optimum, so the gradient is not ~0.
   w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
   w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
@@ -121,13 +130,41 @@ void checkGradient(bool rolling, bool single_target = false) {
       EXPECT_NEAR(g[k * kd + i], num, 0.03 * std::abs(num) + 0.01 * scale) << "keyframe " << k << " dim " << i;
     }
   }
+  const Eigen::Index nc = H.rows() - static_cast<Eigen::Index>(ba.points().size());  // camera dimensions
+  ASSERT_EQ(nc, 3 * kd + (line_delay_estimated ? 1 : 0));
+  if (line_delay_estimated) {
+    // The images see only line_delay x twist (rs_projection.h: t(v) = line_delay (v - y0)), so scaling
+    // the delay is scaling every twist: dE/d ld = sum_k xi_k . dE/d xi_k / ld exactly. The analytic
+    // entry must satisfy that identity with the analytic twist gradients (checked above against numeric
+    // differences). The numeric difference of the delay itself is a sum of such terms that cancel ~20x
+    // (each |xi_k| |dE/d xi_k| / ld ~ 1e8 against a gradient of ~1e7), so the images' ~1 % gradient
+    // error shows there 7-10x larger, as in a host's pose (measured 10 % and 7 % short): 15 %.
+    const double ld = globals.state.line_delay_s, eps = 1e-3 * ld;
+    globals.state.line_delay_s = ld + eps;
+    const double ep = ba.linearize(w.window, prior);
+    globals.state.line_delay_s = ld - eps;
+    const double em = ba.linearize(w.window, prior);
+    globals.state.line_delay_s = ld;
+    const double num = (ep - em) / (2 * eps);
+    double identity = 0.0, terms = 0.0;
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 6; ++i) {
+        const double xi = w.window[k]->state.twist[i];
+        identity += xi * g[k * kd + StateLayout::kTwist + i] / ld;
+        terms += std::abs(xi * num_g[k * kd + StateLayout::kTwist + i]) / ld;
+      }
+    if (getenv("BA_GRAD_VERBOSE")) printf("line delay analytic %.6g numeric %.6g identity %.6g terms %.6g\n", g[3 * kd], num, identity, terms);
+    EXPECT_NEAR(g[3 * kd], identity, 1e-6 * std::abs(identity)) << "line delay against the twists";
+    EXPECT_NEAR(g[3 * kd], num, 0.15 * std::abs(num)) << "line delay";
+    EXPECT_GT(std::abs(num), 0.01 * terms);  // the delay does move the energy
+  }
   // Inverse depths (every 8th point), bounded against the largest of them.
   std::vector<std::pair<double, double>> pg;  // (analytic, numeric)
   const std::vector<ActivePoint*> pts = ba.points();
   for (size_t j = 0; j < pts.size(); j += 8) {
     ba.linearize(w.window, prior);
     ba.fullSystem(&H, &b);
-    const double ga = -2.0 * b[3 * kd + static_cast<int>(j)];
+    const double ga = -2.0 * b[nc + static_cast<Eigen::Index>(j)];
     ActivePoint& p = *ba.points()[j];
     const double rho = p.idepth, eps = 1e-4 * rho;
     p.idepth = rho + eps;
@@ -147,6 +184,8 @@ TEST(BundleAdjustmentGradient, GlobalShutterMatchesNumericDifferences) { checkGr
 TEST(BundleAdjustmentGradient, RollingShutterMatchesNumericDifferences) { checkGradient(true); }
 TEST(BundleAdjustmentGradient, GlobalShutterSingleTargetEachBlockAtItsOwnScale) { checkGradient(false, true); }
 TEST(BundleAdjustmentGradient, RollingShutterSingleTargetEachBlockAtItsOwnScale) { checkGradient(true, true); }
+TEST(BundleAdjustmentGradient, EstimatedLineDelayMatchesNumericDifferences) { checkGradient(true, false, true); }
+TEST(BundleAdjustmentGradient, EstimatedLineDelaySingleTarget) { checkGradient(true, true, true); }
 
 }  // namespace
 }  // namespace rsvio

@@ -30,8 +30,10 @@ struct TestWindow {
   // twist_scale multiplies the per-keyframe twists (rolling shutter: a stronger readout distortion).
   // smooth_twists: every twist is the poses' own constant velocity (the keyframes lie on one
   // constant-twist motion, 0.1 s apart), as the smooth-motion term assumes.
+  // rotation_scale multiplies the rotation between keyframes (a faster turn: a stronger readout effect).
   explicit TestWindow(int n, bool rolling = false, double line_delay_s = 0.0, double twist_scale = 1.0,
-                      double texel_m = 0.012, bool smooth_twists = false) {
+                      double texel_m = 0.012, bool smooth_twists = false, double rotation_scale = 1.0) {
+    const Vec6 step = tw(-0.12, 0.02, -0.05, 0.01 * rotation_scale, -0.02 * rotation_scale, 0.005 * rotation_scale);
     if (texel_m != 0.012) {
       const Eigen::Vector3d X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
       scene.setPlanes({{Eigen::Vector3d(-3, -3, 4.0), X, Y, texel_m, 0},
@@ -42,9 +44,9 @@ struct TestWindow {
     timing = rolling ? RowTiming::rolling(K.height * 0.5 - 0.5, line_delay_s, true) : RowTiming::global(K.height * 0.5 - 0.5);
     for (int i = 0; i < n; ++i) {
       KeyframeState s;
-      s.T_c_w = SE3d::exp(tw(-0.12 * i, 0.02 * i, -0.05 * i, 0.01 * i, -0.02 * i, 0.005 * i));
+      s.T_c_w = SE3d::exp(step * i);
       if (rolling) s.twist = twist_scale * tw(0.6 - 0.1 * i, 0.2, 0.3, 0.3, -0.5 + 0.1 * i, 0.2);
-      if (rolling && smooth_twists) s.twist = tw(-0.12, 0.02, -0.05, 0.01, -0.02, 0.005) / 0.1;
+      if (rolling && smooth_twists) s.twist = step / 0.1;
       truth.push_back(s);
       auto kf = std::make_unique<Keyframe>();
       kf->frame_index = 10 * i;

@@ -88,6 +88,7 @@ TEST(StatesSchema, RoundTripAndBadLine) {
   a.twist << 0.5, 0.1, -0.1, 0.2, 0.3, -0.4;
   a.scale = 2.5;
   a.time_offset_ms = 14.75;
+  a.line_delay_us = 58.94;
   const auto path = tmpFile("states.csv");
   writeStates({a, a}, path);
   auto rows = readStates(path);
@@ -96,14 +97,20 @@ TEST(StatesSchema, RoundTripAndBadLine) {
   EXPECT_NEAR((rows[0].twist - a.twist).norm(), 0, 1e-8);
   EXPECT_DOUBLE_EQ(rows[1].scale, 2.5);
   EXPECT_DOUBLE_EQ(rows[1].time_offset_ms, 14.75);
-  // A file written before the time_offset_ms column (17 columns) still reads, with offset 0.
-  std::ofstream(path, std::ios::app) << "12,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1\n";
+  EXPECT_DOUBLE_EQ(rows[1].line_delay_us, 58.94);
+  // Files written before the time_offset_ms column (17 columns) and before the line_delay_us column
+  // (18) still read, with those values 0.
+  std::ofstream(path, std::ios::app) << "12,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1\n"
+                                     << "13,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1,2.5\n";
   rows = readStates(path);
-  ASSERT_EQ(rows.size(), 3u);
+  ASSERT_EQ(rows.size(), 4u);
   EXPECT_DOUBLE_EQ(rows[2].time_offset_ms, 0.0);
+  EXPECT_DOUBLE_EQ(rows[2].line_delay_us, 0.0);
+  EXPECT_DOUBLE_EQ(rows[3].time_offset_ms, 2.5);
+  EXPECT_DOUBLE_EQ(rows[3].line_delay_us, 0.0);
   std::ofstream(path, std::ios::app) << "12,1,2\n";
   const auto msg = errorOf([&] { readStates(path); });
-  EXPECT_NE(msg.find(path + ":5: expected 18 columns, found 3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(path + ":6: expected 19 columns, found 3"), std::string::npos) << msg;
   fs::remove(path);
 }
 

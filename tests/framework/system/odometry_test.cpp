@@ -57,6 +57,28 @@ TEST(Odometry, TinyRollingShutterSequenceIsTrackedByTheRollingShutterModel) {
   }
 }
 
+// The line delay unknown (issue 13 item 3): rs_vo with estimate_line_delay starting from half the true
+// 117.88 us per row estimates it online and tracks tiny_rs through with an error near the run that is
+// given it. Measured: 134.7 us (14 % high; from 0: 133.8 us), ATE 8.5 mm against 9.9 mm given (from 0:
+// 12.1 mm). The images fix line_delay x twist; the twists, tied to 3 s of keyframe poses, set the rest.
+// A delay held at its start (estimation off) stays at 58.9 us and fails the first check.
+TEST(Odometry, TinyRollingShutterLineDelayIsEstimatedOnline) {
+  const std::string data = simDataset("tiny_rs");
+  const double truth_us = 117.88;
+  const test::RunOutcome given = runDataset(data, runConfig("rs_vo", {"shutter.params.line_delay_us=117.88"}));
+  ASSERT_FALSE(given.failed) << given.reason;
+  const test::RunOutcome est = runDataset(
+      data, runConfig("rs_vo", {"shutter.params.line_delay_us=58.94", "shutter.params.estimate_line_delay=true"}));
+  ASSERT_FALSE(est.failed) << est.reason;
+  EXPECT_EQ(est.untracked_after_first, 0);
+  ASSERT_FALSE(est.shutter.is_null());
+  EXPECT_TRUE(est.shutter.value("line_delay_estimated", false));
+  const double final_us = est.shutter.value("line_delay_us", 0.0);
+  EXPECT_NEAR(final_us, truth_us, 0.2 * truth_us) << "the line delay ends at " << final_us << " us";
+  EXPECT_LT(est.ate_rmse_m, std::max(1.5 * given.ate_rmse_m, given.ate_rmse_m + 0.003))
+      << "estimated " << est.ate_rmse_m << " m, given " << given.ate_rmse_m << " m";
+}
+
 TEST(Odometry, FramesOfNoiseNeverInitialiseAndTheRunFailsWithAReason) {
   const std::string data = simDataset("tiny_gs");
   nlohmann::json cfg = runConfig("gs_vo");

@@ -59,6 +59,7 @@ struct RunOutcome {
   double ate_rmse_m = -1.0;     // keyframes, Sim(3), against the dataset's camera ground truth (VO)
   double path_m = 0.0;
   nlohmann::json vio;           // Odometry::inertialReport() (null for VO)
+  nlohmann::json shutter;       // Odometry::shutterReport() (null for a global shutter)
 };
 
 // Feeds the dataset to the estimator. `modify(i, frame)` may replace images (broken-input tests).
@@ -102,6 +103,7 @@ inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& c
   out.stage_ms = odo.stageMs();
   out.diagnostics_rows = odo.diagnostics().observations.size();
   out.vio = odo.inertialReport();
+  out.shutter = odo.shutterReport();
   // Camera ground truth: body poses mapped through the calibration's T_B_C.
   const auto gt_path = io::findDatasetGroundTruth(dataset);
   if (gt_path && out.kf_traj.size() >= 3 && out.kf_traj.frame == io::PoseFrame::kCamera) {

@@ -2,6 +2,8 @@
 // from (param over calibration), the error when neither knows a line delay, and param validation.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "support/plugin_contracts.h"
 
 namespace rsvio::test {
@@ -21,8 +23,24 @@ TEST(RollingShutter, NoLineDelayAnywhereIsAConfigError) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), "shutter.rolling needs line_delay_us: the calibration has no line delay; give it "
                                      "with --set shutter.params.line_delay_us=<microseconds per row> (readout time / "
-                                     "image rows)");
+                                     "image rows), or estimate it with --set shutter.params.estimate_line_delay=true");
   }
+}
+
+// estimate_line_delay: no delay anywhere is fine, the estimate starts from 0 and the readout direction
+// is kept in the sign bit of the zero derivative (-0.0 bottom_up), so RowTiming knows it.
+TEST(RollingShutter, EstimatedLineDelayMayStartFromZero) {
+  for (const char* readout : {"top_down", "bottom_up"}) {
+    auto s = makePlugin<ShutterModel>("shutter.rolling", {{"estimate_line_delay", true}, {"readout", readout}});
+    s->setCalibration(calibWithout());
+    EXPECT_TRUE(s->estimatesLineDelay());
+    EXPECT_EQ(s->lineDelay(), 0.0);
+    EXPECT_EQ(std::signbit(s->rowTimeDerivative()), std::string(readout) == "bottom_up") << readout;
+  }
+  auto given = makePlugin<ShutterModel>("shutter.rolling", {{"estimate_line_delay", true}, {"line_delay_us", 40.0}});
+  given->setCalibration(calibWithout());
+  EXPECT_DOUBLE_EQ(given->lineDelay(), 40e-6);  // the start
+  EXPECT_FALSE(makePlugin<ShutterModel>("shutter.rolling", {{"line_delay_us", 40.0}})->estimatesLineDelay());
 }
 
 TEST(RollingShutter, ParamLineDelayIsUsedWhenTheCalibrationHasNone) {

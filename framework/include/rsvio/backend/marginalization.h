@@ -18,9 +18,9 @@
 //   their zero rows then drop out of the pseudo-inverse, which conditions on them as known values.
 // - Keyframes are identified by Keyframe*; blocks are ordered by entry. All keyframes in the prior are
 //   in the window. A block is the keyframe's full state (StateLayout::stateDim(): photometric, then
-//   inertial when visual-inertial); a visual-inertial prior ends with the global block (T_Wm_Wf, time
-//   offset: StateLayout::globalDim()) of the GlobalStates given by setGlobals(), whose linearisation
-//   point is frozen the first time a term reaches it. addTo() scatters the blocks to the window
+//   inertial when visual-inertial); a prior whose layout has global states ends with the global block
+//   (T_Wm_Wf, time offset, line delay: StateLayout::globalDim()) of the GlobalStates given by
+//   setGlobals(), whose linearisation point is frozen the first time a term reaches it. addTo() scatters the blocks to the window
 //   system's photometric, inertial and global offsets (window.h).
 #pragma once
 #include <Eigen/Core>
@@ -44,10 +44,11 @@ class MarginalizationPrior {
   // Gives kf a block (zero information) and freezes its linearisation point at its current state.
   void addKeyframe(Keyframe* kf);
 
-  // Visual-inertial: the global states of the window (their delta enters the prior's).
+  // The global states of the window (visual-inertial, estimated line delay; their delta enters the prior's).
   void setGlobals(GlobalStates* g);
   // The inertial state joins (visual-inertial initialisation): every block grows by an empty inertial
-  // block and an empty global block is appended. The shutter cannot change.
+  // block and the global block by its empty inertial part (in front of the line delay). The shutter
+  // and the line-delay estimation cannot change.
   void setLayout(const StateLayout& layout);
 
   // Adds a term linearised at the current states. H_t, b_t are over `kfs` (each kfDim() rows, or each
@@ -62,8 +63,9 @@ class MarginalizationPrior {
   // projected off H_t and b_t (H_t <- P H_t P, b_t <- P b_t, P = I - u u^T). H_t is linearised at the
   // current state, so its null direction is the scale at x, not at x_lin; summed with earlier terms it
   // would give the prior information on the scale, which the photometric energy does not have.
+  // with_global: H_t, b_t end with the global block as in addTerm (its rows are not projected).
   void addScaleFreeTerm(const std::vector<Keyframe*>& kfs, const Eigen::MatrixXd& H_t, const Eigen::VectorXd& b_t,
-                        bool project_scale);
+                        bool project_scale, bool with_global = false);
 
   // Removes kf's block by the Schur complement (see the contract).
   void marginalizeKeyframe(Keyframe* kf);

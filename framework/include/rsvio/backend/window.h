@@ -12,9 +12,11 @@
 //   inertial block (kImuDim = 9, visual-inertial only): IMU velocity v in W_m [0, 3), gyro bias [3, 6),
 //   accelerometer bias [6, 9) (additive); global block (globalDim()): T_Wm_Wf as (omega; sigma), LEFT
 //   perturbation of RxSO3 (sigma = log scale) [0, 4), then the camera-IMU time offset in seconds [4]
-//   when it is estimated. The points couple only to photometric blocks, so the photometric kernels
-//   keep their fixed block size; a keyframe's full state (stateDim(): photometric then inertial) is
-//   contiguous in the marginalisation prior.
+//   when it is estimated (visual-inertial only), then the rolling shutter's line delay in seconds per
+//   row (additive) when it is estimated (lineDelayIndex(); visual odometry too, where it is the whole
+//   global block). The points couple to photometric blocks and, through the line delay, to that one
+//   global entry; the photometric kernels keep their fixed block size; a keyframe's full state
+//   (stateDim(): photometric then inertial) is contiguous in the marginalisation prior.
 // - A point is hosted by a keyframe at an integer level-0 pixel (u, v) of its RAW image, with the unit
 //   bearing of that pixel and its inverse depth rho = 1 / distance along the bearing; it is fixed in
 //   the world at the host row's capture time (rs_projection.h, "host-frame points").
@@ -48,11 +50,13 @@ struct KeyframeState {
   Vec3 bias_accel = Vec3::Zero();
 };
 
-// The window's global states (visual-inertial only): the scale-gravity transform T_Wm_Wf (paper eq. 2,
-// p_Wm = s R_g p_Wf) and the camera-IMU time offset t_imu = t_cam + time_offset_s (Kalibr's sign).
+// The window's global states: visual-inertial, the scale-gravity transform T_Wm_Wf (paper eq. 2,
+// p_Wm = s R_g p_Wf) and the camera-IMU time offset t_imu = t_cam + time_offset_s (Kalibr's sign);
+// rolling shutter with estimate_line_delay, the line delay (s per raw row, RowTiming::line_delay_s).
 struct GlobalState {
   RxSO3d T_wm_wf;
   double time_offset_s = 0.0;
+  double line_delay_s = 0.0;
 };
 
 struct GlobalStates {
@@ -71,10 +75,15 @@ struct StateLayout {
   bool rolling = false;
   bool inertial = false;
   bool estimate_time_offset = false;  // inertial only
+  bool estimate_line_delay = false;   // rolling only
   int kfDim() const { return rolling ? 14 : 8; }  // photometric block
   int imuDim() const { return inertial ? kImuDim : 0; }
   int stateDim() const { return kfDim() + imuDim(); }  // a keyframe's full state
-  int globalDim() const { return inertial ? (estimate_time_offset ? 5 : 4) : 0; }
+  // The global block: the inertial part (T_Wm_Wf, time offset), then the line delay.
+  int inertialGlobalDim() const { return inertial ? (estimate_time_offset ? 5 : 4) : 0; }
+  bool lineDelay() const { return rolling && estimate_line_delay; }
+  int globalDim() const { return inertialGlobalDim() + (lineDelay() ? 1 : 0); }
+  int lineDelayIndex() const { return inertialGlobalDim(); }  // inside the global block (when lineDelay())
   // Offsets in the window system of n keyframes.
   int photometricOffset(int k) const { return k * kfDim(); }
   int imuOffset(int k, int n) const { return n * kfDim() + k * kImuDim; }
@@ -173,8 +182,8 @@ Eigen::VectorXd stateDelta(const KeyframeState& x, const KeyframeState& lin, con
 // Applies a full-state step (stateDim(), the order above): T <- exp(d) T, the rest additive.
 void applyStep(KeyframeState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout);
 
-// The same for the global block (globalDim()): T_Wm_Wf <- exp(omega, sigma) T_Wm_Wf, offset additive;
-// the delta is log(T T_lin^-1).
+// The same for the global block (globalDim()): T_Wm_Wf <- exp(omega, sigma) T_Wm_Wf, offset and line
+// delay additive; the delta is log(T T_lin^-1), x - x_lin.
 Eigen::VectorXd globalDelta(const GlobalState& x, const GlobalState& lin, const StateLayout& layout);
 void applyGlobalStep(GlobalState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout);
 

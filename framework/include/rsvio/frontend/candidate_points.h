@@ -92,6 +92,8 @@ class CandidateTracer {
  public:
   CandidateTracer(const CandidateOptions& options, const ResidualOptions& residual, const CameraModel& camera,
                   const RowTiming& timing);
+  // A new line delay (estimated online): later traces use it.
+  void setTiming(const RowTiming& timing) { timing_ = timing; }
 
   // Candidates at pixels of a keyframe (its level-0 image). Pixels whose pattern leaves the image or
   // that the camera cannot unproject are dropped.

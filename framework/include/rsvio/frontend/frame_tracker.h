@@ -141,6 +141,8 @@ struct TrackResult {
 class FrameTracker {
  public:
   FrameTracker(const TrackerOptions& options, const CameraModel& camera, const RowTiming& timing);
+  // A new line delay (estimated online); takes effect with the next setReference().
+  void setTiming(const RowTiming& timing) { timing_ = timing; }
   ~FrameTracker();
   FrameTracker(const FrameTracker&) = delete;
   FrameTracker& operator=(const FrameTracker&) = delete;

@@ -52,9 +52,8 @@ struct RowTiming {
   static RowTiming rolling(double y0, double line_delay_s, bool top_down) {
     return RowTiming{y0, line_delay_s, top_down ? 1.0 : -1.0};
   }
-  // From the plugins: y0 from the camera's calibration; the direction from the sign of
-  // rowTimeDerivative(). A rolling shutter whose line delay is exactly 0 reports no sign and is taken
-  // as top_down (then only d uv / d line_delay would have the wrong sign).
+  // From the plugins: y0 from the camera's calibration; the direction from the sign bit of
+  // rowTimeDerivative() (a zero line delay read bottom_up reports -0.0, shutter.h).
   static RowTiming from(const ShutterModel& shutter, const CameraModel& camera);
 };
 

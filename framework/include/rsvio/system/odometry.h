@@ -77,6 +77,9 @@ class Odometry {
   // "scale_at_initialisation", "gravity_direction_wf", "time_offset_ms", "time_offset_estimated"};
   // null for visual odometry. usesImu() is true once initialised.
   nlohmann::json inertialReport() const;
+  // Rolling shutter (null for a global shutter): the line delay the run ended with, whether it was
+  // estimated online and where the estimate started (report.json "shutter").
+  nlohmann::json shutterReport() const;
   std::vector<std::string> warnings() const;
 
   struct Impl;
