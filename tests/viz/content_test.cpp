@@ -124,13 +124,13 @@ TEST_F(FigureContent, StatesShowOnlyWhatTheRunEstimated) {
   const auto vo = keyframeStatePanels(snap.states, std::isfinite(snap.summary.scale), &missing);
   ASSERT_EQ(vo.size(), 1u);
   EXPECT_EQ(vo[0].title, "Keyframe twist (per second)");
-  EXPECT_EQ(missing.size(), 5u) << "velocity, two biases, the time offset and the scale are not estimated";
+  EXPECT_EQ(missing.size(), 6u) << "velocity, two biases, the time offset, the line delay and the scale are not estimated";
   // Every panel shown has data that is not a flat zero.
   test::TempDir tmp2("content_states_vio");
   const auto vio = test::makeRun(tmp2.path, test::RunSpec{});
   const io::Snapshot s2 = io::readSnapshot(vio.string());
   const auto all = keyframeStatePanels(s2.states, true);
-  EXPECT_EQ(all.size(), 6u);
+  EXPECT_EQ(all.size(), 7u);
   for (const auto& p : all) {
     bool nonzero = false;
     for (const auto& s : p.series)
@@ -146,7 +146,7 @@ TEST_F(FigureContent, StatesShowOnlyWhatTheRunEstimated) {
   const cv::Mat img = cv::imread((run / "figures/states.png").string());
   EXPECT_EQ(img.rows, 270) << "one panel: one figure high";
   const std::string html = slurp(run / "index.html");
-  EXPECT_NE(html.find("Not estimated (no panel): Velocity (world), Gyroscope bias, Accelerometer bias, Time offset, Scale"),
+  EXPECT_NE(html.find("Not estimated (no panel): Velocity (world), Gyroscope bias, Accelerometer bias, Time offset, Line delay, Scale"),
             std::string::npos);
   EXPECT_NE(html.find("mean per call [ms]"), std::string::npos);
 }

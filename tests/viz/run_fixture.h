@@ -103,12 +103,14 @@ inline fs::path makeRun(const fs::path& dir, const RunSpec& spec) {
       r.twist << 1.0, 0, 0, 0, 0, 0.05 * std::sin(0.1 * i);
       r.scale = 1.0 + 0.001 * i;
       r.time_offset_ms = 15.0 * (1.0 - std::exp(-0.05 * i));  // estimated online, converging
+      r.line_delay_us = 58.94 * (1.0 - 0.5 * std::exp(-0.05 * i));  // the same, from half
       if (spec.vo_states) {
         r.v.setZero();
         r.bg.setZero();
         r.ba.setZero();
         r.scale = 1.0;
         r.time_offset_ms = 0.0;
+        r.line_delay_us = 0.0;
       }
       rows.push_back(r);
     }
