@@ -56,7 +56,8 @@ void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleA
       for (int i = 0; i < 8; ++i) f[i] = 1;
     if (!cfg.estimate_affine) f[StateLayout::kAffine] = f[StateLayout::kAffine + 1] = 1;
   }
-  if (m.gl >= 0 && nk < cfg.line_delay_min_keyframes) m.fixed[static_cast<size_t>(m.gl)] = 1;
+  if (m.gl >= 0 && (nk == 0 || window.back()->kf_id + 1 < cfg.line_delay_min_keyframes))
+    m.fixed[static_cast<size_t>(m.gl)] = 1;
   // The yaw of T_Wm_Wf about gravity is unobservable (visual_inertial_factor.h): held.
   if (cfg.layout.inertial) m.fixed[static_cast<size_t>(cfg.layout.globalOffset(nk) + StateLayout::kGlobalRot + 2)] = 1;
   // Arena of per-point blocks: host + one per observation at most.

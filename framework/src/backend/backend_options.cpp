@@ -16,6 +16,9 @@ ParamTable backendParamTable() {
                "keyframes kept at least when marginalising by the point/brightness tests (DSO: 5)"),
       paramInt("active_points", d.active_points, 10, 100000, "", "target number of active points in the window"),
       paramInt("max_iterations", d.max_iterations, 1, 100, "", "Levenberg-Marquardt iterations per new keyframe"),
+      paramInt("line_delay_hold_keyframes", d.line_delay_hold_keyframes, 2, 100000, "",
+               "an estimated line delay (shutter.rolling estimate_line_delay) is held at its start until the run "
+               "has made this many keyframes"),
       paramDouble("lambda_initial", d.lambda_initial, 0.0, 1e6, "", "initial relative LM damping"),
       paramDouble("step_threshold", d.step_threshold, 0.0, 1.0, "",
                   "stop iterating when the relative energy decrease is below this"),
@@ -78,6 +81,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.min_keyframes = static_cast<int>(p.getInt("min_keyframes"));
   o.active_points = static_cast<int>(p.getInt("active_points"));
   o.max_iterations = static_cast<int>(p.getInt("max_iterations"));
+  o.line_delay_hold_keyframes = static_cast<int>(p.getInt("line_delay_hold_keyframes"));
   o.lambda_initial = p.getDouble("lambda_initial");
   o.step_threshold = p.getDouble("step_threshold");
   o.marg_weight_factor = p.getDouble("marg_weight_factor");

@@ -324,6 +324,7 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["min_keyframes"] = o.min_keyframes;
   got["active_points"] = o.active_points;
   got["max_iterations"] = o.max_iterations;
+  got["line_delay_hold_keyframes"] = o.line_delay_hold_keyframes;
   got["lambda_initial"] = o.lambda_initial;
   got["step_threshold"] = o.step_threshold;
   got["marg_weight_factor"] = o.marg_weight_factor;

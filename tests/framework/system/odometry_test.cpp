@@ -61,6 +61,8 @@ TEST(Odometry, TinyRollingShutterSequenceIsTrackedByTheRollingShutterModel) {
 // 117.88 us per row estimates it online and tracks tiny_rs through with an error near the run that is
 // given it. Measured: 134.7 us (14 % high; from 0: 133.8 us), ATE 8.5 mm against 9.9 mm given (from 0:
 // 12.1 mm). The images fix line_delay x twist; the twists, tied to 3 s of keyframe poses, set the rest.
+// The delay is released after 5 keyframes instead of the default 20 (docs/rolling_shutter.md): this
+// sequence has 33 in all, and held at half the delay for 20 of them it is lost at frame 14.
 // A delay held at its start (estimation off) stays at 58.9 us and fails the first check.
 TEST(Odometry, TinyRollingShutterLineDelayIsEstimatedOnline) {
   const std::string data = simDataset("tiny_rs");
@@ -68,7 +70,8 @@ TEST(Odometry, TinyRollingShutterLineDelayIsEstimatedOnline) {
   const test::RunOutcome given = runDataset(data, runConfig("rs_vo", {"shutter.params.line_delay_us=117.88"}));
   ASSERT_FALSE(given.failed) << given.reason;
   const test::RunOutcome est = runDataset(
-      data, runConfig("rs_vo", {"shutter.params.line_delay_us=58.94", "shutter.params.estimate_line_delay=true"}));
+      data, runConfig("rs_vo", {"shutter.params.line_delay_us=58.94", "shutter.params.estimate_line_delay=true",
+                                "backend.line_delay_hold_keyframes=5"}));
   ASSERT_FALSE(est.failed) << est.reason;
   EXPECT_EQ(est.untracked_after_first, 0);
   ASSERT_FALSE(est.shutter.is_null());

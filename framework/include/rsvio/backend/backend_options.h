@@ -29,6 +29,7 @@ struct BackendOptions {
   double min_idepth_hessian_marg = 50.0;  // a point leaving the window goes into the prior above this (DSO)
   int min_good_residuals = 3;         // observations a point needs to be kept / marginalised (DSO: 3)
   double twist_regularization = 1e-6; // tiny information on twists without a prior (rolling shutter)
+  int line_delay_hold_keyframes = 20; // an estimated line delay is held until the run has this many keyframes
   // Keyframe selection (DSO's weights; the flows are RMS pixel shifts normalised by width + height).
   double kf_weight_t = 0.04 * (640 + 480);   // translation-only flow
   double kf_weight_rt = 0.02 * (640 + 480);  // full flow

@@ -74,9 +74,10 @@ struct BundleAdjustmentConfig {
   // step, so the damping cannot move the scale (DSO orthogonalises its steps the same way). Off when
   // a term makes the scale observable (IMU).
   bool fix_scale_gauge = true;
-  // An estimated line delay is held (a fixed dimension) while the window has fewer keyframes: in the
-  // first windows after the monocular start the twists are barely tied to the poses and the delay,
-  // seen only through line_delay x twist, runs away (measured on tiny_rs: 59 -> 750 us at 2 keyframes).
+  // An estimated line delay is held (a fixed dimension) until the newest keyframe's kf_id + 1 (the
+  // keyframes made over the run) reaches this: in the first windows after the monocular start the
+  // twists are barely tied to the poses and the delay, seen only through line_delay x twist, runs away
+  // (measured on tiny_rs: 59 -> 750 us at 2 keyframes). backend.line_delay_hold_keyframes.
   int line_delay_min_keyframes = 5;
   int threads = 1;                 // 1 or 2
 };
