@@ -86,20 +86,20 @@ std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool h
     p.series = {s};
     panels.push_back(std::move(p));
   };
-  // The camera-IMU time offset over time, when it moved (estimated online; constant when assumed).
-  bool offset_moves = false;
-  for (const auto& r : rows) offset_moves |= std::abs(r.time_offset_ms - rows.front().time_offset_ms) > 1e-6;
-  if (offset_moves)
-    scalar("Camera-IMU time offset (t_imu = t_cam + offset)", "offset [ms]", Rgb{140, 86, 75}, &StateRow::time_offset_ms);
-  else if (not_estimated)
-    not_estimated->push_back("Time offset");
-  // The rolling shutter's line delay over time, when it moved (estimated online; constant when given).
-  bool delay_moves = false;
-  for (const auto& r : rows) delay_moves |= std::abs(r.line_delay_us - rows.front().line_delay_us) > 1e-6;
-  if (delay_moves)
-    scalar("Rolling-shutter line delay", "line delay [us/row]", Rgb{23, 190, 207}, &StateRow::line_delay_us);
-  else if (not_estimated)
-    not_estimated->push_back("Line delay");
+  // A calibration state over time when it moved (estimated online; constant when assumed or given).
+  auto calibration = [&](const char* name, const char* title, const char* ylabel, Rgb colour,
+                         double StateRow::*field) {
+    bool moves = false;
+    for (const auto& r : rows) moves |= std::abs(r.*field - rows.front().*field) > 1e-6;
+    if (moves)
+      scalar(title, ylabel, colour, field);
+    else if (not_estimated)
+      not_estimated->push_back(name);
+  };
+  calibration("Time offset", "Camera-IMU time offset (t_imu = t_cam + offset)", "offset [ms]", Rgb{140, 86, 75},
+              &StateRow::time_offset_ms);
+  calibration("Line delay", "Rolling-shutter line delay", "line delay [us/row]", Rgb{23, 190, 207},
+              &StateRow::line_delay_us);
   if (has_scale)
     scalar("Scale (metres per visual unit)", "scale", Rgb{148, 103, 189}, &StateRow::scale);
   else if (not_estimated)

@@ -98,6 +98,16 @@ struct TestWindow {
     }
   }
 
+  // Every keyframe gets an active smooth-motion term with its window neighbours (smooth_motion_term.h).
+  void linkMotionNeighbours() {
+    for (size_t i = 0; i < window.size(); ++i) {
+      Keyframe& kf = *window[i];
+      kf.motion_term = true;
+      kf.motion_prev = i > 0 ? window[i - 1].get() : nullptr;
+      kf.motion_next = i + 1 < window.size() ? window[i + 1].get() : nullptr;
+    }
+  }
+
   int numPoints() const {
     int n = 0;
     for (const auto& kf : window) n += static_cast<int>(kf->points.size());

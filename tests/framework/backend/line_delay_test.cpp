@@ -35,12 +35,7 @@ struct LineDelayWindow {
     w.addPoints(0, 400);
     w.addPoints(2, 300, 9);
     w.window[0]->gauge = true;
-    for (size_t i = 0; i < w.window.size(); ++i) {
-      Keyframe& kf = *w.window[i];
-      kf.motion_term = true;
-      kf.motion_prev = i > 0 ? w.window[i - 1].get() : nullptr;
-      kf.motion_next = i + 1 < w.window.size() ? w.window[i + 1].get() : nullptr;
-    }
+    w.linkMotionNeighbours();
     SmoothMotionOptions so;
     so.information.diagonal() << Vec3::Constant(info), Vec3::Constant(info);
     term = std::make_unique<SmoothMotionTerm>(so);

@@ -192,11 +192,9 @@ TEST(SmoothMotionTerm, RollingShutterWindowTwistsConvergeFromALooseStart) {
   w.addPoints(0, 400);
   w.addPoints(2, 300, 9);
   w.window[0]->gauge = true;
+  w.linkMotionNeighbours();
   for (size_t i = 0; i < w.window.size(); ++i) {
     Keyframe& kf = *w.window[i];
-    kf.motion_term = true;
-    kf.motion_prev = i > 0 ? w.window[i - 1].get() : nullptr;
-    kf.motion_next = i + 1 < w.window.size() ? w.window[i + 1].get() : nullptr;
     kf.state.twist += tw(0.2, -0.2, 0.1, 0.1, 0.1, -0.1);
   }
   const SmoothMotionTerm term(options(1e4, 1e4));
