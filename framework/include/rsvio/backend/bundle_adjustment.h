@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "rsvio/backend/backend_options.h"
 #include "rsvio/backend/marginalization.h"
 #include "rsvio/backend/window.h"
 #include "rsvio/geometry/rs_projection.h"
@@ -77,8 +78,9 @@ struct BundleAdjustmentConfig {
   // An estimated line delay is held (a fixed dimension) until the newest keyframe's kf_id + 1 (the
   // keyframes made over the run) reaches this: in the first windows after the monocular start the
   // twists are barely tied to the poses and the delay, seen only through line_delay x twist, runs away
-  // (measured on tiny_rs: 59 -> 750 us at 2 keyframes). backend.line_delay_hold_keyframes.
-  int line_delay_min_keyframes = 5;
+  // (measured on tiny_rs: 59 -> 750 us at 2 keyframes). Odometry sets it from
+  // backend.line_delay_hold_keyframes; the default is that option's.
+  int line_delay_min_keyframes = BackendOptions{}.line_delay_hold_keyframes;
   int threads = 1;                 // 1 or 2
 };
 
