@@ -240,92 +240,100 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
   for (const auto& w : source->warnings()) report.warnings.push_back(w);
 
   const auto t_start = Clock::now();
-  Odometry odo(cfg, host, sensors);
-  OutputStreams streams(odo, request.out_dir, cfg, report.warnings);
-  const auto& imu = source->imu();
-  size_t imu_next = 0;
-  const size_t n = source->numFrames();
   const double rate = sensors.camera.rate_hz > 0 ? sensors.camera.rate_hz : 20.0;
-  // IMU samples up to half a frame past the frame's time on the IMU clock (more is harmless).
-  const double offset_s = inertialOptionsFromConfig(cfg).assumedTimeOffsetS(sensors.camera);
-  const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(std::abs(offset_s));
-  auto last_print = Clock::now();
-  long processed = 0;
-  auto interrupted = [&] {
-    if (runInterruptSignal() == 0) return false;
-    report.status = "interrupted";
-    report.error = std::string("interrupted by ") + (runInterruptSignal() == SIGTERM ? "SIGTERM" : "SIGINT") +
-                   " after " + std::to_string(processed) + " of " + std::to_string(n) + " frames";
-    return true;
-  };
-  for (size_t i = 0; i < n && !odo.failed(); ++i) {
-    if (interrupted()) break;
-    const int64_t t_f = source->frameTime(i);
-    while (imu_next < imu.size() && imu[imu_next].t_ns <= t_f + lookahead_ns) odo.addImu(imu[imu_next++]);
-    Frame frame;
-    try {
-      frame = source->readFrame(i);
-    } catch (const Error& e) {
-      report.status = "failed";
-      report.error = e.what();
-      break;
+  {  // The odometry and the dataset live until the outputs are written; evaluation runs without them.
+    Odometry odo(cfg, host, sensors);
+    OutputStreams streams(odo, request.out_dir, cfg, report.warnings);
+    // IMU samples are streamed from the dataset, not held: memory stays flat on long recordings.
+    std::unique_ptr<ImuReader> imu = sensors.has_imu ? source->imuReader() : nullptr;
+    ImuSample imu_next;
+    bool imu_pending = imu && imu->next(imu_next);
+    const size_t n = source->numFrames();
+    // IMU samples up to half a frame past the frame's time on the IMU clock (more is harmless).
+    const double offset_s = inertialOptionsFromConfig(cfg).assumedTimeOffsetS(sensors.camera);
+    const int64_t lookahead_ns = static_cast<int64_t>(0.5e9 / rate) + sToNs(std::abs(offset_s));
+    auto last_print = Clock::now();
+    long processed = 0;
+    auto interrupted = [&] {
+      if (runInterruptSignal() == 0) return false;
+      report.status = "interrupted";
+      report.error = std::string("interrupted by ") + (runInterruptSignal() == SIGTERM ? "SIGTERM" : "SIGINT") +
+                     " after " + std::to_string(processed) + " of " + std::to_string(n) + " frames";
+      return true;
+    };
+    for (size_t i = 0; i < n && !odo.failed(); ++i) {
+      if (interrupted()) break;
+      const int64_t t_f = source->frameTime(i);
+      Frame frame;
+      try {
+        while (imu_pending && imu_next.t_ns <= t_f + lookahead_ns) {
+          odo.addImu(imu_next);
+          imu_pending = imu->next(imu_next);
+        }
+        frame = source->readFrame(i);
+      } catch (const Error& e) {
+        report.status = "failed";
+        report.error = e.what();
+        break;
+      }
+      FrameStatus st;
+      try {
+        st = odo.addFrame(frame);  // throws DataError for a frame that does not fit the calibration
+      } catch (const Error& e) {
+        report.status = "failed";
+        report.error = e.what();
+        break;
+      }
+      ++processed;
+      streams.take();
+      const bool print_now = request.verbosity >= 2 || (request.verbosity >= 1 && secondsSince(last_print) > 2.0);
+      if (print_now || (request.verbosity >= 1 && i + 1 == n)) {
+        const double el = secondsSince(t_start);
+        std::printf("[%zu/%zu] %.1f fps (camera %.0f Hz), %ld keyframes%s%s\n", i + 1, n,
+                    el > 0 ? processed / el : 0.0, rate, odo.numKeyframes(), st.message.empty() ? "" : ", ",
+                    st.message.c_str());
+        std::fflush(stdout);
+        last_print = Clock::now();
+      }
     }
-    FrameStatus st;
-    try {
-      st = odo.addFrame(frame);  // throws DataError for a frame that does not fit the calibration
-    } catch (const Error& e) {
-      report.status = "failed";
-      report.error = e.what();
-      break;
-    }
-    ++processed;
-    streams.take();
-    const bool print_now = request.verbosity >= 2 || (request.verbosity >= 1 && secondsSince(last_print) > 2.0);
-    if (print_now || (request.verbosity >= 1 && i + 1 == n)) {
-      const double el = secondsSince(t_start);
-      std::printf("[%zu/%zu] %.1f fps (camera %.0f Hz), %ld keyframes%s%s\n", i + 1, n,
-                  el > 0 ? processed / el : 0.0, rate, odo.numKeyframes(), st.message.empty() ? "" : ", ",
-                  st.message.c_str());
-      std::fflush(stdout);
-      last_print = Clock::now();
-    }
-  }
-  if (report.status == "ok") interrupted();  // a signal during the last frame
-  if (!odo.failed() && report.status == "ok") {
-    odo.finish();
-  } else if (odo.failed() && report.status == "ok") {
-    // A run the odometry gave up on still logs its window (diagnostics rows of the observations in it,
-    // the keyframes' last states, the points): `rsvio diagnose` works from what was there when it
-    // failed, also when it failed before anything was marginalised. finish() skips the optimisation of
-    // a failed estimator.
-    try {
+    if (report.status == "ok") interrupted();  // a signal during the last frame
+    if (!odo.failed() && report.status == "ok") {
       odo.finish();
-    } catch (const std::exception& e) {
-      report.warnings.push_back(std::string("the failed run's window could not be written out: ") + e.what());
+    } else if (odo.failed() && report.status == "ok") {
+      // A run the odometry gave up on still logs its window (diagnostics rows of the observations in it,
+      // the keyframes' last states, the points): `rsvio diagnose` works from what was there when it
+      // failed, also when it failed before anything was marginalised. finish() skips the optimisation of
+      // a failed estimator.
+      try {
+        odo.finish();
+      } catch (const std::exception& e) {
+        report.warnings.push_back(std::string("the failed run's window could not be written out: ") + e.what());
+      }
     }
-  }
-  const double wall = secondsSince(t_start);
-  if (odo.failed() && report.status != "interrupted") {
-    report.status = "failed";
-    report.error = odo.failureReason();
-  }
-  report.frames = processed;
-  report.keyframes = odo.numKeyframes();
-  report.fps = wall > 0 ? processed / wall : 0.0;
-  report.realtime_factor = report.fps / rate;
-  report.stage_ms = odo.stageMs();
-  if (odo.usesImu()) report.scale = odo.scale();
-  if (const nlohmann::json vio = odo.inertialReport(); !vio.is_null()) {
-    report.extra["vio"] = vio;
-    if (!odo.usesImu())
-      report.warnings.push_back("the visual-inertial initialisation did not succeed (" +
-                                vio["status"].get<std::string>() + "): the outputs are visual odometry, "
-                                "camera poses without metric scale");
-  }
-  if (const nlohmann::json sh = odo.shutterReport(); !sh.is_null()) report.extra["shutter"] = sh;
-  for (const auto& w : odo.warnings()) report.warnings.push_back(w);
+    const double wall = secondsSince(t_start);
+    if (odo.failed() && report.status != "interrupted") {
+      report.status = "failed";
+      report.error = odo.failureReason();
+    }
+    report.frames = processed;
+    report.keyframes = odo.numKeyframes();
+    report.fps = wall > 0 ? processed / wall : 0.0;
+    report.realtime_factor = report.fps / rate;
+    report.stage_ms = odo.stageMs();
+    if (odo.usesImu()) report.scale = odo.scale();
+    if (const nlohmann::json vio = odo.inertialReport(); !vio.is_null()) {
+      report.extra["vio"] = vio;
+      if (!odo.usesImu())
+        report.warnings.push_back("the visual-inertial initialisation did not succeed (" +
+                                  vio["status"].get<std::string>() + "): the outputs are visual odometry, "
+                                  "camera poses without metric scale");
+    }
+    if (const nlohmann::json sh = odo.shutterReport(); !sh.is_null()) report.extra["shutter"] = sh;
+    for (const auto& w : odo.warnings()) report.warnings.push_back(w);
 
-  writeOutputs(odo, request.out_dir, streams, report.warnings);
+    writeOutputs(odo, request.out_dir, streams, report.warnings);
+  }
+  source.reset();
   // A failed run is evaluated too: what it estimated before the failure is worth a figure.
   if (cfg["output"]["evaluate"].get<bool>()) evaluate(request.data_dir, request.out_dir, report);
   report.write((fs::path(request.out_dir) / "report.json").string());

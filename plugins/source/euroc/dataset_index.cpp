@@ -6,7 +6,6 @@
 #include <cstdio>
 
 #include "rsvio/core/error.h"
-#include "rsvio/io/csv.h"
 
 namespace rsvio::euroc {
 
@@ -87,28 +86,37 @@ std::vector<CameraIndexEntry> readCameraIndex(const std::string& csv_path, std::
   return out;
 }
 
-ImuReadResult readImuCsv(const std::string& csv_path, std::vector<std::string>& warnings) {
+namespace {
+io::CsvFormat imuCsvFormat() {
   io::CsvFormat fmt;
   fmt.skip_text_header = true;
-  io::CsvReader csv(csv_path,
-                    {"timestamp [ns]", "w_RS_S_x [rad s^-1]", "w_RS_S_y [rad s^-1]", "w_RS_S_z [rad s^-1]",
-                     "a_RS_S_x [m s^-2]", "a_RS_S_y [m s^-2]", "a_RS_S_z [m s^-2]"},
-                    fmt);
-  ImuReadResult out;
-  WarningSink nonfinite(warnings, "IMU samples with NaN/inf values dropped");
-  WarningSink dup(warnings, "duplicate IMU timestamps dropped");
-  while (csv.next()) {
+  return fmt;
+}
+}  // namespace
+
+ImuCsvStream::ImuCsvStream(const std::string& csv_path, std::vector<std::string>* warnings)
+    : warnings_(warnings ? *warnings : dropped_),
+      csv_(csv_path,
+           {"timestamp [ns]", "w_RS_S_x [rad s^-1]", "w_RS_S_y [rad s^-1]", "w_RS_S_z [rad s^-1]",
+            "a_RS_S_x [m s^-2]", "a_RS_S_y [m s^-2]", "a_RS_S_z [m s^-2]"},
+           imuCsvFormat()),
+      nonfinite_(warnings_, "IMU samples with NaN/inf values dropped"),
+      dup_(warnings_, "duplicate IMU timestamps dropped") {}
+
+bool ImuCsvStream::next(ImuSample& out) {
+  while (!done_ && csv_.next()) {
+    if (&warnings_ == &dropped_) dropped_.clear();  // nobody reads them: keep nothing
     ImuSample s;
     double v[6];
     try {
-      csv.expectFieldCount();
-      s.t_ns = csv.getInt64(0);
-      for (int k = 0; k < 6; ++k) v[k] = csv.getDouble(static_cast<size_t>(k) + 1);
+      csv_.expectFieldCount();
+      s.t_ns = csv_.getInt64(0);
+      for (int k = 0; k < 6; ++k) v[k] = csv_.getDouble(static_cast<size_t>(k) + 1);
     } catch (const DataError& err) {
-      if (!csv.rowUnterminated()) throw;
-      warnings.push_back(csv.size() < 7 ? truncatedMessage(csv, 7, "sample")
-                                        : std::string(err.what()) + " (last line, no newline at the end of the "
-                                                                    "file: truncated write?); sample dropped");
+      if (!csv_.rowUnterminated()) throw;
+      warnings_.push_back(csv_.size() < 7 ? truncatedMessage(csv_, 7, "sample")
+                                          : std::string(err.what()) + " (last line, no newline at the end of the "
+                                                                      "file: truncated write?); sample dropped");
       continue;
     }
     int bad = -1;
@@ -116,51 +124,55 @@ ImuReadResult readImuCsv(const std::string& csv_path, std::vector<std::string>& 
       if (!std::isfinite(v[k])) bad = k;
     if (bad >= 0) {
       const size_t f = static_cast<size_t>(bad) + 1;
-      nonfinite.add(csv.path() + ":" + std::to_string(csv.line()) + ":" + std::to_string(csv.column(f)) +
-                    ": field '" + csv.fieldName(f) + "' is " + csv.raw(f) + "; IMU sample dropped");
+      nonfinite_.add(csv_.path() + ":" + std::to_string(csv_.line()) + ":" + std::to_string(csv_.column(f)) +
+                     ": field '" + csv_.fieldName(f) + "' is " + csv_.raw(f) + "; IMU sample dropped");
       continue;
     }
-    if (!out.samples.empty()) {
-      const int64_t prev = out.samples.back().t_ns;
-      if (s.t_ns < prev)
-        throw csv.errorAt(0, "timestamp " + std::to_string(s.t_ns) + " ns is earlier than " + std::to_string(prev) +
-                                 " ns on line " + std::to_string(out.lines.back()) + " (IMU timestamps must increase)");
-      if (s.t_ns == prev) {
-        dup.add(csv.path() + ":" + std::to_string(csv.line()) + ":" + std::to_string(csv.column(0)) +
-                ": duplicate IMU timestamp " + std::to_string(s.t_ns) + " ns (also on line " +
-                std::to_string(out.lines.back()) + "); sample dropped");
+    if (any_) {
+      if (s.t_ns < prev_t_)
+        throw csv_.errorAt(0, "timestamp " + std::to_string(s.t_ns) + " ns is earlier than " + std::to_string(prev_t_) +
+                                  " ns on line " + std::to_string(line_) + " (IMU timestamps must increase)");
+      if (s.t_ns == prev_t_) {
+        dup_.add(csv_.path() + ":" + std::to_string(csv_.line()) + ":" + std::to_string(csv_.column(0)) +
+                 ": duplicate IMU timestamp " + std::to_string(s.t_ns) + " ns (also on line " + std::to_string(line_) +
+                 "); sample dropped");
         continue;
       }
     }
     s.gyro_rad_s = Vec3(v[0], v[1], v[2]);
     s.accel_m_s2 = Vec3(v[3], v[4], v[5]);
-    out.samples.push_back(s);
-    out.lines.push_back(csv.line());
+    any_ = true;
+    prev_t_ = s.t_ns;
+    line_ = csv_.line();
+    out = s;
+    return true;
   }
-  nonfinite.finish();
-  dup.finish();
-  noteHeader(csv, warnings);
-  return out;
+  if (!done_) {
+    done_ = true;
+    nonfinite_.finish();
+    dup_.finish();
+    noteHeader(csv_, warnings_);
+  }
+  return false;
 }
 
-void checkImuGaps(const std::string& csv_path, const ImuReadResult& imu, int64_t max_gap_ns, int64_t t_begin_ns,
-                  int64_t t_end_ns, std::vector<std::string>& warnings) {
-  WarningSink outside(warnings, "IMU gaps outside the camera's time span");
-  for (size_t i = 1; i < imu.samples.size(); ++i) {
-    const int64_t a = imu.samples[i - 1].t_ns, b = imu.samples[i].t_ns;
-    if (b - a <= max_gap_ns) continue;
-    char buf[200];
-    std::snprintf(buf, sizeof(buf), "gap of %.1f ms in the IMU data between %s (line %ld) and %s exceeds "
-                  "max_imu_gap_ms = %.1f", (b - a) * 1e-6, formatStamp(a).c_str(), imu.lines[i - 1],
-                  formatStamp(b).c_str(), max_gap_ns * 1e-6);
-    const bool inside = b > t_begin_ns && a < t_end_ns;
-    if (inside)
-      throw DataError::at(csv_path, imu.lines[i], std::string(buf) +
-                                                      " inside the camera's time span (samples missing? raise "
-                                                      "params.max_imu_gap_ms to accept it)");
-    outside.add(csv_path + ":" + std::to_string(imu.lines[i]) + ": " + buf + " outside the camera's time span");
-  }
-  outside.finish();
+void ImuGapCheck::add(int64_t t_ns, long line) {
+  const bool first = !any_;
+  const int64_t a = prev_t_, b = t_ns;
+  const long a_line = prev_line_;
+  any_ = true;
+  prev_t_ = t_ns;
+  prev_line_ = line;
+  if (first || b - a <= max_gap_ns_) return;
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "gap of %.1f ms in the IMU data between %s (line %ld) and %s exceeds "
+                "max_imu_gap_ms = %.1f", (b - a) * 1e-6, formatStamp(a).c_str(), a_line, formatStamp(b).c_str(),
+                max_gap_ns_ * 1e-6);
+  if (b > t_begin_ && a < t_end_)
+    throw DataError::at(path_, line, std::string(buf) +
+                                         " inside the camera's time span (samples missing? raise "
+                                         "params.max_imu_gap_ms to accept it)");
+  outside_.add(path_ + ":" + std::to_string(line) + ": " + buf + " outside the camera's time span");
 }
 
 }  // namespace rsvio::euroc

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "rsvio/core/types.h"
+#include "rsvio/io/csv.h"
 
 namespace rsvio::euroc {
 
@@ -26,19 +27,6 @@ struct CameraIndexEntry {
 
 // Reads camN/data.csv. Warnings are appended to `warnings`.
 std::vector<CameraIndexEntry> readCameraIndex(const std::string& csv_path, std::vector<std::string>& warnings);
-
-struct ImuReadResult {
-  std::vector<ImuSample> samples;
-  std::vector<long> lines;  // line of each kept sample in data.csv, for gap messages
-};
-
-// Reads imu0/data.csv. Warnings are appended to `warnings` (at most a few per kind, then a count).
-ImuReadResult readImuCsv(const std::string& csv_path, std::vector<std::string>& warnings);
-
-// Checks the gaps between consecutive IMU samples against max_gap_ns: a gap overlapping
-// [t_begin_ns, t_end_ns] (the camera's span on the IMU clock) throws DataError, others become warnings.
-void checkImuGaps(const std::string& csv_path, const ImuReadResult& imu, int64_t max_gap_ns, int64_t t_begin_ns,
-                  int64_t t_end_ns, std::vector<std::string>& warnings);
 
 // Collects repeated warnings of one kind: the first `keep` verbatim, then a count.
 class WarningSink {
@@ -54,6 +42,48 @@ class WarningSink {
   size_t keep_;
   size_t count_ = 0;
 };
+
+// Reads imu0/data.csv one kept sample at a time (bounded memory: long recordings are streamed, never
+// held). Warnings are appended to `warnings` as they come (at most a few per kind, then a count when the
+// stream ends); with warnings == nullptr they are dropped (a second pass over a file open() checked).
+class ImuCsvStream {
+ public:
+  ImuCsvStream(const std::string& csv_path, std::vector<std::string>* warnings);
+  bool next(ImuSample& s);              // the next kept sample; false at the end; throws DataError
+  long line() const { return line_; }   // data.csv line of the sample next() returned last
+  const std::string& path() const { return csv_.path(); }
+
+ private:
+  std::vector<std::string> dropped_;    // warnings when the caller wants none
+  std::vector<std::string>& warnings_;
+  io::CsvReader csv_;
+  WarningSink nonfinite_, dup_;
+  int64_t prev_t_ = 0;
+  long line_ = 0;
+  bool any_ = false, done_ = false;
+};
+
+// Checks the gaps between consecutive IMU samples, fed in order, against max_gap_ns: a gap overlapping
+// [t_begin_ns, t_end_ns] (the camera's span on the IMU clock) throws DataError, others become warnings
+// (appended on finish()).
+class ImuGapCheck {
+ public:
+  ImuGapCheck(std::string csv_path, int64_t max_gap_ns, int64_t t_begin_ns, int64_t t_end_ns,
+              std::vector<std::string>& warnings)
+      : path_(std::move(csv_path)), max_gap_ns_(max_gap_ns), t_begin_(t_begin_ns), t_end_(t_end_ns),
+        outside_(warnings, "IMU gaps outside the camera's time span") {}
+  void add(int64_t t_ns, long line);
+  void finish() { outside_.finish(); }
+
+ private:
+  std::string path_;
+  int64_t max_gap_ns_, t_begin_, t_end_;
+  WarningSink outside_;
+  int64_t prev_t_ = 0;
+  long prev_line_ = 0;
+  bool any_ = false;
+};
+
 
 // "1403636579.763555584 s" from ns, exactly.
 std::string formatStamp(int64_t t_ns);

@@ -92,6 +92,9 @@ void EurocSource::open(const std::string& dir) {
   sensors_ = SensorSetup();
   frames_.clear();
   imu_.clear();
+  imu_loaded_ = false;
+  imu_csv_.clear();
+  imu_count_ = 0;
   warnings_.clear();
   resolveFolders(dir);
   readCalibration();
@@ -230,20 +233,35 @@ void EurocSource::readImu() {
     warnings_.push_back(csv.string() + " not found: no IMU data (visual-only runs only)");
     return;
   }
-  ImuReadResult r = readImuCsv(csv.string(), warnings_);
-  if (r.samples.empty()) {
-    warnings_.push_back(csv.string() + ": no IMU samples: no IMU data (visual-only runs only)");
-    return;
-  }
+  // One streaming pass checks the whole file (errors and warnings belong to open()); nothing of it is
+  // kept but its span and the first steps (the rate): runs stream it again through imuReader().
   // The camera's span on the IMU clock (t_imu = t_cam + time_offset).
   const int64_t off = static_cast<int64_t>(std::llround(sensors_.camera.time_offset_s * 1e9));
   const int64_t t0 = frames_.front().t_ns + off, t1 = frames_.back().t_ns + off;
-  checkImuGaps(csv.string(), r, static_cast<int64_t>(std::llround(opt_.max_imu_gap_ms * 1e6)), t0, t1, warnings_);
-  if (r.samples.front().t_ns > t0)
-    warnings_.push_back(csv.string() + ": IMU data starts " + fmt("%.1f", (r.samples.front().t_ns - t0) * 1e-6) +
+  std::vector<std::string> gap_warnings;  // after the reader's, as when the gaps were checked after reading
+  ImuCsvStream stream(csv.string(), &warnings_);
+  ImuGapCheck gaps(csv.string(), static_cast<int64_t>(std::llround(opt_.max_imu_gap_ms * 1e6)), t0, t1, gap_warnings);
+  constexpr size_t kRateSamples = 20001;  // the median step of the first 20000 steps gives the rate
+  std::vector<int64_t> t;
+  int64_t t_first = 0, t_last = 0;
+  size_t count = 0;
+  for (ImuSample s; stream.next(s); ++count) {
+    gaps.add(s.t_ns, stream.line());
+    if (count == 0) t_first = s.t_ns;
+    t_last = s.t_ns;
+    if (t.size() < kRateSamples) t.push_back(s.t_ns);
+  }
+  if (count == 0) {
+    warnings_.push_back(csv.string() + ": no IMU samples: no IMU data (visual-only runs only)");
+    return;
+  }
+  gaps.finish();
+  warnings_.insert(warnings_.end(), gap_warnings.begin(), gap_warnings.end());
+  if (t_first > t0)
+    warnings_.push_back(csv.string() + ": IMU data starts " + fmt("%.1f", (t_first - t0) * 1e-6) +
                         " ms after the first frame: the frames before it have no IMU data");
-  if (r.samples.back().t_ns < t1)
-    warnings_.push_back(csv.string() + ": IMU data ends " + fmt("%.1f", (t1 - r.samples.back().t_ns) * 1e-6) +
+  if (t_last < t1)
+    warnings_.push_back(csv.string() + ": IMU data ends " + fmt("%.1f", (t1 - t_last) * 1e-6) +
                         " ms before the last frame: the frames after it have no IMU data");
 
   // Noise densities: explicit file, EuRoC's sensor.yaml, TUM-VI's imu_config.yaml, Kalibr's beside the camchain.
@@ -273,9 +291,6 @@ void EurocSource::readImu() {
     warnings_.push_back("no IMU noise calibration found (mav0/imu0/sensor.yaml, dso/imu_config.yaml); using "
                         "rsvio's defaults (EuRoC's ADIS16448 values)");
   sensors_.imu = cal.noise;
-  std::vector<int64_t> t;
-  t.reserve(r.samples.size());
-  for (const auto& s : r.samples) t.push_back(s.t_ns);
   const int64_t step = medianStep(t);
   const double measured_hz = step > 0 ? 1e9 / static_cast<double>(step) : 0.0;
   if (!cal.rate_found && measured_hz > 0) {
@@ -287,8 +302,40 @@ void EurocSource::readImu() {
   // Our body frame is the IMU: a EuRoC rig whose IMU is not at the body origin is re-expressed.
   if (!cal.T_B_S.isApprox(Eigen::Isometry3d::Identity()) && calib_format_ == "euroc")
     sensors_.camera.T_B_C = cal.T_B_S.inverse() * sensors_.camera.T_B_C;
-  imu_ = std::move(r.samples);
+  imu_csv_ = csv.string();
+  imu_count_ = count;
   sensors_.has_imu = true;
+}
+
+namespace {
+class CsvImuReader : public ImuReader {
+ public:
+  explicit CsvImuReader(const std::string& path) : stream_(path, nullptr) {}
+  bool next(ImuSample& s) override { return stream_.next(s); }
+
+ private:
+  ImuCsvStream stream_;
+};
+
+class EmptyImuReader : public ImuReader {
+ public:
+  bool next(ImuSample&) override { return false; }
+};
+}  // namespace
+
+std::unique_ptr<ImuReader> EurocSource::imuReader() const {
+  if (imu_csv_.empty()) return std::make_unique<EmptyImuReader>();
+  return std::make_unique<CsvImuReader>(imu_csv_);
+}
+
+const std::vector<ImuSample>& EurocSource::imu() const {
+  if (!imu_loaded_ && !imu_csv_.empty()) {
+    imu_.reserve(imu_count_);
+    auto r = imuReader();
+    for (ImuSample s; r->next(s);) imu_.push_back(s);
+  }
+  imu_loaded_ = true;
+  return imu_;
 }
 
 }  // namespace rsvio::euroc

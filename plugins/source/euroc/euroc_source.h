@@ -50,7 +50,8 @@ class EurocSource : public DataSource {
   size_t numFrames() const override { return frames_.size(); }
   int64_t frameTime(size_t i) const override;
   Frame readFrame(size_t i) const override;
-  const std::vector<ImuSample>& imu() const override { return imu_; }
+  const std::vector<ImuSample>& imu() const override;      // read on first call (diagnose, tests)
+  std::unique_ptr<ImuReader> imuReader() const override;  // streamed from data.csv (runs)
   std::vector<std::string> warnings() const override { return warnings_; }
 
  private:
@@ -75,7 +76,10 @@ class EurocSource : public DataSource {
   EurocSourceOptions opt_;
   SensorSetup sensors_;
   std::vector<FrameEntry> frames_;
-  std::vector<ImuSample> imu_;
+  std::string imu_csv_;                       // imu0/data.csv when has_imu (checked whole by open())
+  size_t imu_count_ = 0;                      // samples kept by open()'s pass
+  mutable std::vector<ImuSample> imu_;        // imu()'s copy, read on its first call
+  mutable bool imu_loaded_ = false;
   std::vector<std::string> warnings_;
 
   std::string dir_, mav0_, cam_dir_, index_path_;

@@ -202,6 +202,36 @@ TEST(BadInput, DuplicateImuTimestampDropsTheLaterSampleWithAWarning) {
   EXPECT_TRUE(anyContains(src->warnings(), "(also on line 6); sample dropped")) << joined(src->warnings());
 }
 
+// Runs stream the IMU (DataSource::imuReader) instead of holding it: the reader must keep exactly
+// the samples open() kept (a dropped duplicate, NaN and a truncated last line here) and add no warning.
+TEST(BadInput, StreamedImuKeepsTheSamplesOpenKept) {
+  TempDir tmp;
+  writeDataset(tmp.path(), DatasetSpec());
+  std::string lines = imuLines(0, 5) + imuLine(4, "0.3") + imuLines(5, 10) + imuLine(10, "nan") +
+                      imuLines(11, kImuCount) + "123";
+  writeImuLines(tmp.path(), lines);
+  auto src = opened(tmp.path());
+  const size_t warnings = src->warnings().size();
+  EXPECT_GE(warnings, 3u) << joined(src->warnings());
+  auto reader = src->imuReader();
+  std::vector<ImuSample> streamed;
+  for (ImuSample s; reader->next(s);) streamed.push_back(s);
+  EXPECT_EQ(src->warnings().size(), warnings);
+  const std::vector<ImuSample>& all = src->imu();
+  ASSERT_EQ(streamed.size(), static_cast<size_t>(kImuCount - 1));
+  ASSERT_EQ(streamed.size(), all.size());
+  for (size_t k = 0; k < all.size(); ++k) {
+    EXPECT_EQ(streamed[k].t_ns, all[k].t_ns);
+    EXPECT_EQ(streamed[k].gyro_rad_s, all[k].gyro_rad_s);
+    EXPECT_EQ(streamed[k].accel_m_s2, all[k].accel_m_s2);
+  }
+  EXPECT_DOUBLE_EQ(streamed[4].accel_m_s2.y(), 0.2);  // the first of the duplicates
+  // A second reader starts from the first sample again.
+  ImuSample first;
+  ASSERT_TRUE(src->imuReader()->next(first));
+  EXPECT_EQ(first.t_ns, all.front().t_ns);
+}
+
 TEST(BadInput, DecreasingImageTimestampIsFatal) {
   TempDir tmp;
   writeDataset(tmp.path(), DatasetSpec());
