@@ -11,6 +11,10 @@
 #
 # Usage: bash scripts/acceptance_vio.sh [OUT_DIR] [SEED ...]   (default out/acceptance_vio, seeds 1 2 3)
 #   RSVIO_BIN  the binary (default build/bin/rsvio)
+#   MODES      the runs per seed (default "rsvio_rs gsvio_rs gsvio_gs"); rsviodm_rs and gsviodm_gs are
+#              rs_vio on RS and gs_vio on the twin with imu.dynamic_marginalization=true
+#   SETS       more --set lines for every run, e.g. SETS="imu.init_scale_factor=1.3"
+#   TAG        appended to the run folders (run_s<seed>_<mode><TAG>), to keep variants apart
 # Datasets are simulated once into OUT_DIR/med_<rs|gs>_s<seed> and reused (about 3 min each on 2 cores);
 # each run takes 0.5-1 min; two runs go at a time.
 set -euo pipefail
@@ -20,6 +24,7 @@ shift || true
 SEEDS=("$@")
 [ ${#SEEDS[@]} -gt 0 ] || SEEDS=(1 2 3)
 BIN=${RSVIO_BIN:-build/bin/rsvio}
+MODES=${MODES:-rsvio_rs gsvio_rs gsvio_gs}
 [ -x "$BIN" ] || { echo "acceptance_vio: $BIN not found; run scripts/build.sh or set RSVIO_BIN" >&2; exit 2; }
 mkdir -p "$OUT"
 
@@ -40,8 +45,13 @@ run_one() {  # seed mode
     rsvio_rs) cfg=configs/rs_vio.json; data="$OUT/med_rs_s$seed"; sets=(--set shutter.params.line_delay_us=58.94) ;;
     gsvio_rs) cfg=configs/gs_vio.json; data="$OUT/med_rs_s$seed" ;;
     gsvio_gs) cfg=configs/gs_vio.json; data="$OUT/med_gs_s$seed" ;;
+    rsviodm_rs) cfg=configs/rs_vio.json; data="$OUT/med_rs_s$seed"
+                sets=(--set shutter.params.line_delay_us=58.94 --set imu.dynamic_marginalization=true) ;;
+    gsviodm_gs) cfg=configs/gs_vio.json; data="$OUT/med_gs_s$seed"; sets=(--set imu.dynamic_marginalization=true) ;;
+    *) echo "acceptance_vio: unknown mode $mode" >&2; return 1 ;;
   esac
-  local run="$OUT/run_s${seed}_$mode"
+  for s in ${SETS:-}; do sets+=(--set "$s"); done
+  local run="$OUT/run_s${seed}_$mode${TAG:-}"
   "$BIN" -q run --config "$cfg" --data "$data" --out "$run" --set output.render=false "${sets[@]}" > "$run.log" 2>&1 \
     || echo "   (seed $seed $mode failed: see $run/report.json)"
   # The Sim(3) figures (report.json holds the SE(3) ones of metric outputs).
@@ -50,7 +60,7 @@ run_one() {  # seed mode
 
 jobs=()
 for seed in "${SEEDS[@]}"; do
-  for mode in rsvio_rs gsvio_rs gsvio_gs; do jobs+=("$seed $mode"); done
+  for mode in $MODES; do jobs+=("$seed $mode"); done
 done
 for ((i = 0; i < ${#jobs[@]}; i += 2)); do
   echo "== ${jobs[$i]}${jobs[$((i + 1))]:+, ${jobs[$((i + 1))]}}"
@@ -59,25 +69,25 @@ for ((i = 0; i < ${#jobs[@]}; i += 2)); do
   wait
 done
 
-python3 - "$OUT" "${SEEDS[@]}" <<'EOF'
+python3 - "$OUT" "$MODES" "${TAG:-}" "${SEEDS[@]}" <<'EOF'
 import json, sys, os, statistics
-out, seeds = sys.argv[1], sys.argv[2:]
+out, modes, tag, seeds = sys.argv[1], sys.argv[2].split(), sys.argv[3], sys.argv[4:]
 def load(p):
     try:
         return json.load(open(p))
     except Exception:
         return None
 print()
-print("%-4s %-9s %7s %7s %9s %10s %7s %8s %8s %7s  %s" % ("seed", "mode", "status", "frames", "SE3 (mm)", "Sim3 (mm)",
-      "scale", "init (s)", "s_init", "s_end", "error"))
+print("%-4s %-10s %7s %7s %9s %10s %7s %8s %8s %7s %5s  %s" % ("seed", "mode", "status", "frames", "SE3 (mm)",
+      "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "error"))
 med = {}
-for mode in ("rsvio_rs", "gsvio_rs", "gsvio_gs"):
+for mode in modes:
     vals = []
     for seed in seeds:
-        base = os.path.join(out, "run_s%s_%s" % (seed, mode))
+        base = os.path.join(out, "run_s%s_%s%s" % (seed, mode, tag))
         r = load(os.path.join(base, "report.json"))
         if not r:
-            print("%-4s %-9s  (no report)" % (seed, mode)); vals.append(float("inf")); continue
+            print("%-4s %-10s  (no report)" % (seed, mode)); vals.append(float("inf")); continue
         s3 = load(base + ".sim3.json") or {}
         ev = r.get("eval", {})
         vio = r.get("extra", {}).get("vio", {})
@@ -85,12 +95,13 @@ for mode in ("rsvio_rs", "gsvio_rs", "gsvio_gs"):
         se3 = ev.get("ate_rmse_m") if metric else None
         sim3 = s3.get("ate_rmse_m")
         scale = s3.get("alignment", {}).get("scale")
-        data = os.path.join(out, "med_%s_s%s" % ("gs" if mode == "gsvio_gs" else "rs", seed))
+        data = os.path.join(out, "med_%s_s%s" % (mode[-2:], seed))
         t0 = (load(os.path.join(data, "truth.json")) or {}).get("clocks", {}).get("start_ns", 0) * 1e-9
         ok = r["status"] == "ok"
         vals.append(se3 if ok and se3 is not None else float("inf"))
         init_t = vio.get("initialised_at_s")
-        print("%-4s %-9s %7s %7d %9s %10s %7s %8s %8s %7s  %s" % (
+        dm = vio.get("dynamic_marginalization")
+        print("%-4s %-10s %7s %7d %9s %10s %7s %8s %8s %7s %5s  %s" % (
             seed, mode, r["status"], r.get("frames", 0),
             "%.1f" % (1e3 * se3) if se3 is not None else "-",
             "%.1f" % (1e3 * sim3) if sim3 is not None else "-",
@@ -98,9 +109,10 @@ for mode in ("rsvio_rs", "gsvio_rs", "gsvio_gs"):
             "%.2f" % (init_t - t0) if vio.get("initialised") and init_t else "-",
             "%.3f" % vio["scale_at_initialisation"] if vio.get("initialised") else "-",
             "%.3f" % vio["scale"] if vio.get("initialised") else "-",
+            "%d/%d" % (dm["switches"], dm["half_resets"]) if dm else "-",
             (r.get("error") or "")[:80]))
     med[mode] = statistics.median(vals) if vals else float("nan")
-g = med["gsvio_gs"]
-print("medians of the SE(3) ATE (failed = inf): rs_vio/RS %.1f mm, gs_vio/RS %.1f mm, gs_vio/GS %.1f mm; "
-      "rs_vio on RS vs gs_vio on the twin %.2fx" % (1e3 * med["rsvio_rs"], 1e3 * med["gsvio_rs"], 1e3 * g, med["rsvio_rs"] / g))
+print("medians of the SE(3) ATE (failed = inf): " + ", ".join("%s %.1f mm" % (m, 1e3 * v) for m, v in med.items()))
+if "rsvio_rs" in med and "gsvio_gs" in med:
+    print("rs_vio on RS vs gs_vio on the twin %.2fx" % (med["rsvio_rs"] / med["gsvio_gs"]))
 EOF

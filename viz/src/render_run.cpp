@@ -32,7 +32,7 @@ std::string failureText(const io::Snapshot& s) {
 }  // namespace
 
 std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool has_scale,
-                                       std::vector<std::string>* not_estimated) {
+                                       std::vector<std::string>* not_estimated, const nlohmann::json* dm) {
   std::vector<Panel> panels;
   if (rows.empty()) return panels;
   auto allZero = [&](auto get) {
@@ -100,9 +100,40 @@ std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool h
               &StateRow::time_offset_ms);
   calibration("Line delay", "Rolling-shutter line delay", "line delay [us/row]", Rgb{23, 190, 207},
               &StateRow::line_delay_us);
-  if (has_scale)
-    scalar("Scale (metres per visual unit)", "scale", Rgb{148, 103, 189}, &StateRow::scale);
-  else if (not_estimated)
+  // The scale from the visual-inertial initialisation on (rows before it hold 0).
+  Series sc{"", {}, {}, Rgb{148, 103, 189}};
+  for (size_t i = 0; i < rows.size(); ++i)
+    if (rows[i].scale > 0.0) {
+      sc.x.push_back(t[i]);
+      sc.y.push_back(rows[i].scale);
+    }
+  if (has_scale && !sc.x.empty()) {
+    Panel p;
+    p.title = "Scale (metres per visual unit)";
+    p.y_label = "scale";
+    p.series = {sc};
+    // Dynamic marginalisation's interval, a step at each event, up to the last keyframe.
+    if (dm && dm->is_object() && dm->contains("events") && dm->at("events").is_array() &&
+        dm->value("interval", 0.0) > 1.0) {
+      const double d = dm->at("interval").get<double>(), t_end = t.back();
+      Series lo{"interval (switch when left)", {}, {}, Rgb{150, 150, 150}}, hi{"", {}, {}, Rgb{150, 150, 150}};
+      Series mid{"centre", {}, {}, Rgb{200, 200, 200}};
+      const nlohmann::json& ev = dm->at("events");
+      for (size_t k = 0; k < ev.size(); ++k) {
+        const double t0 = ev[k].value("t_s", 0.0) - rows.front().t_ns * 1e-9;
+        const double t1 = k + 1 < ev.size() ? ev[k + 1].value("t_s", 0.0) - rows.front().t_ns * 1e-9 : t_end;
+        const double c = ev[k].value("centre", 0.0);
+        if (!(c > 0.0) || t1 < t0) continue;
+        for (Series* s : {&lo, &mid, &hi}) {
+          const double y = s == &lo ? c / d : (s == &hi ? c * d : c);
+          s->x.insert(s->x.end(), {t0, t1});
+          s->y.insert(s->y.end(), {y, y});
+        }
+      }
+      if (!lo.x.empty()) p.series = {lo, hi, mid, sc};
+    }
+    panels.push_back(std::move(p));
+  } else if (not_estimated)
     not_estimated->push_back("Scale");
   if (!panels.empty()) panels.back().x_label = "time since first keyframe [s]";
   return panels;
@@ -201,7 +232,11 @@ RenderStatus renderRun(const io::Snapshot& s, const RenderOptions& o) {
       attempt("states.png", st, [&] {
         const auto path = out / "states.png";
         std::vector<std::string> missing;
-        auto panels = keyframeStatePanels(s.states, std::isfinite(s.summary.scale), &missing);
+        const nlohmann::json* dm = nullptr;
+        if (s.report.contains("extra") && s.report["extra"].is_object() && s.report["extra"].contains("vio") &&
+            s.report["extra"]["vio"].is_object() && s.report["extra"]["vio"].contains("dynamic_marginalization"))
+          dm = &s.report["extra"]["vio"]["dynamic_marginalization"];
+        auto panels = keyframeStatePanels(s.states, std::isfinite(s.summary.scale), &missing, dm);
         std::string not_est;
         for (const auto& m : missing) not_est += (not_est.empty() ? "" : ", ") + m;
         // The figure itself says what has no panel, not only the page's caption.

@@ -62,6 +62,7 @@ void MarginalizationPrior::addKeyframe(Keyframe* kf) {
   const int d = layout_.stateDim();
   insertZeros(H_, b_, static_cast<Eigen::Index>(keyframes_.size()) * d, d);
   keyframes_.push_back(kf);
+  if (kf->in_prior) return;  // frozen already (by another prior of DynamicMarginalization)
   kf->in_prior = true;
   kf->lin = kf->state;  // first estimate, frozen from now on
 }

@@ -43,6 +43,14 @@ ParamTable inertialParamTable() {
                   "refuse an initialisation whose IMU factors at its solution (poses held) have a mean whitened "
                   "energy above this (the keyframe poses do not fit the IMU; tried again at the next keyframe); "
                   "0: no test"),
+      paramBool("dynamic_marginalization", d.dynamic_marginalization,
+                "dynamic marginalisation for the scale (VI-DSO): the window switches to a second prior holding "
+                "only newer IMU factors and twist energies when the scale leaves the interval around the first's"),
+      paramDouble("dynamic_marginalization_interval", d.dynamic_marginalization_interval, 1.0001, 100.0, "",
+                  "d of dynamic marginalisation: the priors switch when the scale leaves [s_mid / d, s_mid * d]"),
+      paramDouble("init_scale_factor", d.init_scale_factor, 1e-3, 1e3, "",
+                  "multiplies the scale the initialisation found (an experiment: start the scale wrong and watch "
+                  "it converge; 1 for real runs)"),
       paramDouble("repreintegrate_gyro_bias_rad_s", d.repreintegrate_gyro_bias_rad_s, 0.0, 10.0, "rad/s",
                   "re-preintegrate an IMU factor when the gyro bias moved further from its linearisation"),
       paramDouble("repreintegrate_accel_bias_m_s2", d.repreintegrate_accel_bias_m_s2, 0.0, 100.0, "m/s^2",
@@ -77,6 +85,9 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.init_max_accel_bias_m_s2 = p.getDouble("init_max_accel_bias_m_s2");
   o.init_min_interval_s = p.getDouble("init_min_interval_s");
   o.init_max_imu_chi2 = p.getDouble("init_max_imu_chi2");
+  o.dynamic_marginalization = p.getBool("dynamic_marginalization");
+  o.dynamic_marginalization_interval = p.getDouble("dynamic_marginalization_interval");
+  o.init_scale_factor = p.getDouble("init_scale_factor");
   o.repreintegrate_gyro_bias_rad_s = p.getDouble("repreintegrate_gyro_bias_rad_s");
   o.repreintegrate_accel_bias_m_s2 = p.getDouble("repreintegrate_accel_bias_m_s2");
   o.fail_max_gyro_bias_rad_s = p.getDouble("fail_max_gyro_bias_rad_s");

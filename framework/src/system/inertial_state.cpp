@@ -97,7 +97,7 @@ std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
 }
 
 bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, KeyframeList& window,
-                                  BundleAdjuster& ba, MarginalizationPrior& prior) {
+                                  BundleAdjuster& ba, DynamicMarginalization& prior) {
   if (!o_.enabled || initialised_ || window.empty()) return false;
   const int64_t off = offsetNs();
   std::vector<ViInitKeyframe> kfs;
@@ -140,12 +140,14 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
     return false;
   }
   globals_.state.T_wm_wf = r.T_wm_wf;
-  scale_init_ = r.T_wm_wf.scale();
+  // imu.init_scale_factor (experiments): the metric world scaled about its origin, velocities with it.
+  globals_.state.T_wm_wf.setScale(r.T_wm_wf.scale() * o_.init_scale_factor);
+  scale_init_ = globals_.state.T_wm_wf.scale();
   for (auto& kf : window) {
     kf->state.bias_gyro = r.bias.gyro;
     kf->state.bias_accel = r.bias.accel;
     for (size_t i = 0; i < kfs.size(); ++i)
-      if (kfs[i].t_ns == kf->t_ns) kf->state.v_wm = r.velocities_wm[i];
+      if (kfs[i].t_ns == kf->t_ns) kf->state.v_wm = o_.init_scale_factor * r.velocities_wm[i];
   }
   initialised_ = true;
   init_t_ns_ = window.back()->t_ns;
@@ -171,6 +173,7 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
   ba.setGlobals(&globals_);
   prior.setGlobals(&globals_);
   prior.setLayout(cfg.layout);
+  prior.start(scale_init_, nsToS(init_t_ns_));
   for (auto& kf : window)
     if (kf->in_prior) {  // the prior has no information on these yet: any linearisation point is exact
       kf->lin.v_wm = kf->state.v_wm;
@@ -185,7 +188,7 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
   return true;
 }
 
-void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& window, MarginalizationPrior& prior) const {
+void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& window, DynamicMarginalization& prior) const {
   if (!initialised_) return;
   const StateLayout layout = prior.layout();
   std::vector<Keyframe*> kfs;
@@ -206,7 +209,7 @@ void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& wind
       H.col(z).setZero();
       b[z] = 0.0;
     }
-    prior.addTerm(kfs, H, b, true);
+    prior.addScaleTerm(kfs, H, b, true);  // IMU factors and the twist energy depend on the scale
   }
   leaving.imu_term = false;
   leaving.twist_energy = false;

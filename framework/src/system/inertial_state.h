@@ -23,7 +23,7 @@
 
 #include "rsvio/backend/bundle_adjustment.h"
 #include "rsvio/backend/inertial_term.h"
-#include "rsvio/backend/marginalization.h"
+#include "rsvio/backend/dynamic_marginalization.h"
 #include "rsvio/backend/window.h"
 #include "rsvio/imu/imu_buffer.h"
 #include "rsvio/imu/inertial_options.h"
@@ -55,10 +55,11 @@ class InertialState {
   // Tries the visual-inertial initialisation (see the contract) with the keyframe poses of the run so
   // far (time order, T_Cf_Wf). Returns true when it succeeded now.
   bool tryInitialize(const std::vector<ViInitKeyframe>& keyframes, KeyframeList& window, BundleAdjuster& ba,
-                     MarginalizationPrior& prior);
+                     DynamicMarginalization& prior);
 
   // Before `leaving` leaves the window: its terms (and the factor from it) into the prior, switched off.
-  void marginalizeTerms(Keyframe& leaving, const KeyframeList& window, MarginalizationPrior& prior) const;
+  // The terms depend on the scale: they go to the priors of dynamic marginalisation that keep such terms.
+  void marginalizeTerms(Keyframe& leaving, const KeyframeList& window, DynamicMarginalization& prior) const;
 
   // After an optimisation: re-preintegrates the factors whose bias or offset moved too far.
   void refreshFactors(KeyframeList& window);

@@ -59,7 +59,7 @@ KeyframeWindow::KeyframeWindow(const WindowSetup& setup, const CameraModel& came
     smooth_motion_ = std::make_unique<SmoothMotionTerm>(so);
   }
   updateTerms();
-  prior_ = std::make_unique<MarginalizationPrior>(setup.ba.layout);
+  prior_ = std::make_unique<DynamicMarginalization>(setup.ba.layout, setup.dynamic_marginalization);
   globals_.state.line_delay_s = timing_.line_delay_s;
   if (setup.ba.layout.globalDim() > 0) {
     ba_->setGlobals(&globals_);
@@ -103,14 +103,15 @@ bool KeyframeWindow::initializeInertial(const std::vector<ViInitKeyframe>& keyfr
 }
 
 void KeyframeWindow::optimize(int max_iterations) {
-  last_ba_ = ba_->optimize(window_, *prior_, max_iterations);
+  last_ba_ = ba_->optimize(window_, prior_->active(), max_iterations);
+  if (inertial_ && inertial_->initialised()) prior_->update(inertial_->scale(), nsToS(window_.back()->t_ns));
   if (ba_->config().layout.lineDelay() && timing_.line_delay_s != globals_.state.line_delay_s) {
     timing_.line_delay_s = globals_.state.line_delay_s;
     tracer_->setTiming(timing_);
   }
 }
 
-void KeyframeWindow::evaluate() { ba_->evaluate(window_, *prior_); }
+void KeyframeWindow::evaluate() { ba_->evaluate(window_, prior_->active()); }
 
 void KeyframeWindow::releasePoints(WindowSink& sink) {
   for (auto& kf : window_) {

@@ -6,7 +6,9 @@
 // Owns
 // - the keyframes (KeyframeList, oldest first; Keyframe* stays valid until the keyframe leaves) with
 //   their active points (backend/window.h) and candidate points (frontend/candidate_points.h);
-// - the candidate tracer, the bundle adjuster, the marginalisation prior (FEJ, marginalization.h) and,
+// - the candidate tracer, the bundle adjuster, the marginalisation prior (FEJ, marginalization.h; with
+//   dynamic marginalisation, the three priors of dynamic_marginalization.h, switched after each
+//   optimisation of a visual-inertial run by the scale estimate) and,
 //   for a rolling shutter with a smooth-motion prior, the smooth-motion term (smooth_motion_term.h);
 // - the counters that make ids unique over the run (kf_id, point id), the run's first keyframe (the
 //   gauge), DSO's adaptive activation distance, the last optimisation's statistics and the median
@@ -31,7 +33,7 @@
 
 #include "rsvio/backend/backend_options.h"
 #include "rsvio/backend/bundle_adjustment.h"
-#include "rsvio/backend/marginalization.h"
+#include "rsvio/backend/dynamic_marginalization.h"
 #include "rsvio/backend/smooth_motion_term.h"
 #include "rsvio/backend/window.h"
 #include "rsvio/frontend/candidate_points.h"
@@ -62,6 +64,7 @@ struct WindowSetup {
   BundleAdjustmentConfig ba;         // its layout says whether the shutter is rolling
   bool smooth_motion = false;        // rolling shutter: a smooth-motion term with this information
   Mat6 smooth_motion_information = Mat6::Zero();
+  DynamicMarginalizationOptions dynamic_marginalization;  // visual-inertial (imu.dynamic_marginalization)
 };
 
 class KeyframeWindow {
@@ -114,6 +117,8 @@ class KeyframeWindow {
   std::string divergence(std::string* warning);
 
   const BundleAdjustmentStats& lastStats() const { return last_ba_; }
+  // The marginalisation priors (one, or dynamic marginalisation's three once visual-inertial).
+  const DynamicMarginalization& marginalization() const { return *prior_; }
   // The window's global states (line delay, and T_Wm_Wf and the time offset once visual-inertial) and
   // the row timing with the current line delay (updated by optimize() when it is estimated).
   GlobalStates& globals() { return globals_; }
@@ -143,7 +148,7 @@ class KeyframeWindow {
   std::unique_ptr<CandidateTracer> tracer_;
   std::unique_ptr<BundleAdjuster> ba_;
   std::unique_ptr<SmoothMotionTerm> smooth_motion_;  // rolling shutter with a smooth-motion prior, else null
-  std::unique_ptr<MarginalizationPrior> prior_;
+  std::unique_ptr<DynamicMarginalization> prior_;  // its active() prior is the bundle adjuster's
   InertialState* inertial_ = nullptr;
   KeyframeList window_;
   int64_t next_kf_id_ = 0;

@@ -87,6 +87,8 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   ws.backend = bo;
   ws.frontend = fo;
   ws.seed = seed;
+  ws.dynamic_marginalization.enabled = io.enabled && io.dynamic_marginalization;
+  ws.dynamic_marginalization.interval = io.dynamic_marginalization_interval;
 
   record = std::make_unique<RunRecord>(*camera, timing, rolling, estimate_affine, sensors.camera);
   TrackerOptions to = fo.track;
@@ -125,7 +127,10 @@ void Odometry::Impl::tryInertialInitialisation() {
   for (const auto& [t, T] : by_time) kfs.push_back(ViInitKeyframe{t, T});
   constexpr size_t kMaxInitKeyframes = 30;
   if (kfs.size() > kMaxInitKeyframes) kfs.erase(kfs.begin(), kfs.end() - kMaxInitKeyframes);
-  if (window->initializeInertial(kfs)) vi_init_t_ns = window->newest().t_ns;
+  if (window->initializeInertial(kfs)) {
+    vi_init_t_ns = window->newest().t_ns;
+    record->setMetric();
+  }
 }
 
 void Odometry::Impl::fillInertial(int64_t t_ns) {
@@ -486,6 +491,19 @@ nlohmann::json Odometry::inertialReport() const {
     const Vec3 g = m.inertial->globals().state.T_wm_wf.so3().inverse() * Vec3(0, 0, -1);
     j["gravity_direction_wf"] = {g.x(), g.y(), g.z()};
   }
+  const DynamicMarginalization& dm = m.window->marginalization();
+  if (dm.options().enabled) {
+    nlohmann::json d;
+    d["interval"] = dm.options().interval;
+    d["switches"] = dm.numSwitches();
+    d["half_resets"] = dm.numHalfResets();
+    d["centre"] = dm.centre();
+    nlohmann::json ev = nlohmann::json::array();
+    for (const auto& e : dm.events())
+      ev.push_back({{"t_s", e.t_s}, {"event", eventName(e.event)}, {"scale", e.scale}, {"centre", e.s_mid}});
+    d["events"] = ev;
+    j["dynamic_marginalization"] = d;
+  }
   j["time_offset_estimated"] = m.inertial->options().estimate_time_offset;
   j["time_offset_ms"] = m.inertial->timeOffset() * 1e3;
   return j;
@@ -526,10 +544,7 @@ std::vector<MapPoint> Odometry::points() const {
   return out;
 }
 std::vector<StateRow> Odometry::states() const {
-  std::vector<StateRow> rows = impl_->record->states(impl_->window->keyframes());
-  if (usesImu())
-    for (StateRow& r : rows) r.scale = impl_->inertial->scale();  // the final scale (metres per W_f unit)
-  return rows;
+  return impl_->record->states(impl_->window->keyframes());
 }
 
 }  // namespace rsvio

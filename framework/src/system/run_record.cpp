@@ -67,6 +67,7 @@ void RunRecord::recordKeyframe(const Keyframe& kf) {
   r.t_ns = kf.t_ns;
   r.state = kf.state;
   r.time_offset_s = timeOffset();
+  r.scale = scaleNow();
   r.line_delay_s = rolling_ ? timing_.line_delay_s : 0.0;
   if (rolling_) diag_.line_delay_s = timing_.line_delay_s;  // the log's header: the latest estimate
   if (!rolling_ && kf.has_observed_twist) r.state.twist = kf.observed_twist;
@@ -195,6 +196,7 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     s.bg = r.state.bias_gyro;
     s.ba = r.state.bias_accel;
     s.time_offset_ms = 1e3 * r.time_offset_s;
+    s.scale = r.scale;
     s.line_delay_us = 1e6 * r.line_delay_s;
     rows[r.t_ns] = s;
   }
@@ -206,6 +208,7 @@ std::vector<StateRow> RunRecord::states(const KeyframeList& window) const {
     s.bg = kf->state.bias_gyro;
     s.ba = kf->state.bias_accel;
     s.time_offset_ms = 1e3 * timeOffset();
+    s.scale = scaleNow();
     s.line_delay_us = rolling_ ? 1e6 * timing_.line_delay_s : 0.0;
     rows[kf->t_ns] = s;
   }

@@ -58,6 +58,7 @@ struct KeyframeRecord {
   KeyframeState state;
   double time_offset_s = 0.0;  // the camera-IMU time offset when the record was made (a global state)
   double line_delay_s = 0.0;   // the line delay then (rolling shutter; it may be estimated online)
+  double scale = 0.0;          // the metric scale then (metres per W_f unit; 0 before the VI initialisation)
 };
 
 class RunRecord : public WindowSink {
@@ -74,6 +75,8 @@ class RunRecord : public WindowSink {
   // The global states a keyframe's record also keeps (the time offset); without them, the
   // calibration's offset.
   void setGlobals(const GlobalStates* g) { globals_ = g; }
+  // The scale became metric (visual-inertial initialisation): records from now on carry it.
+  void setMetric() { metric_ = true; }
 
   // Keyframes: the current state of a keyframe (its twist: see the invariants).
   void recordKeyframe(const Keyframe& kf);
@@ -114,6 +117,9 @@ class RunRecord : public WindowSink {
   double time_offset_s_ = 0.0;                   // the calibration's (assumed) offset
   const GlobalStates* globals_ = nullptr;
   double timeOffset() const { return globals_ ? globals_->state.time_offset_s : time_offset_s_; }
+  bool metric_ = false;
+  // StateRow::scale: 1 for visual odometry, 0 before the VI initialisation, then the estimate.
+  double scaleNow() const { return !globals_ ? 1.0 : (metric_ ? globals_->state.T_wm_wf.scale() : 0.0); }
   std::vector<FrameRecord> frames_;
   std::map<int64_t, KeyframeRecord> keyframes_;  // by kf_id, every keyframe of the run
   std::vector<MapPoint> map_points_;             // points that left the window (marginalised)

@@ -41,7 +41,8 @@ class MarginalizationPrior {
   const Eigen::VectorXd& b() const { return b_; }
   int blockOf(const Keyframe* kf) const;  // -1 when kf has no block
 
-  // Gives kf a block (zero information) and freezes its linearisation point at its current state.
+  // Gives kf a block (zero information) and freezes its linearisation point at its current state,
+  // unless it is frozen already (Keyframe::in_prior: the priors of dynamic_marginalization.h share it).
   void addKeyframe(Keyframe* kf);
 
   // The global states of the window (visual-inertial, estimated line delay; their delta enters the prior's).

@@ -38,6 +38,14 @@ struct InertialOptions {
   // the IMU (the rolling-shutter monocular start's distorted first keyframes, docs/vio.md); tried again
   // at the next keyframe. 0: no test.
   double init_max_imu_chi2 = 0.0;
+  // Dynamic marginalisation for the scale (backend/dynamic_marginalization.h): a second prior with only
+  // the scale-dependent terms since the scale entered its current half-interval, switched in when the
+  // scale leaves [s_mid / d, s_mid * d]; d = dynamic_marginalization_interval.
+  bool dynamic_marginalization = false;
+  double dynamic_marginalization_interval = 1.1;
+  // Multiplies the scale the initialisation found (1: as found). For experiments: start the scale wrong
+  // and watch the window bring it back (docs/vio.md, "Dynamic marginalisation").
+  double init_scale_factor = 1.0;
   // Re-preintegrate an IMU factor when the bias moved further than this from its linearisation.
   double repreintegrate_gyro_bias_rad_s = 0.01;
   double repreintegrate_accel_bias_m_s2 = 0.1;

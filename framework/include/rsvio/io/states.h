@@ -3,7 +3,8 @@
 //     line_delay_us
 // v: IMU velocity in the metric world [m/s] (0 without an IMU); bg [rad/s], ba [m/s^2]: biases;
 // xi: the keyframe's camera twist per second (translation; rotation), translation in W_f units per s;
-// scale: metres per W_f unit (1 without an IMU), the final one;
+// scale: metres per W_f unit when the keyframe was last optimised (the estimate over time; 1 without an
+// IMU, 0 before the visual-inertial initialisation);
 // time_offset_ms: the camera-IMU time offset (t_imu = t_cam + offset) when the keyframe was last
 // optimised, so an online estimate shows over time (the assumed value when it is not estimated);
 // line_delay_us: the rolling shutter's line delay [us per row] in the same way (0 for a global shutter).

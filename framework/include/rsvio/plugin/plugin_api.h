@@ -22,8 +22,8 @@
 
 #include "rsvio/plugin/plugin.h"
 
-#define RSVIO_PLUGIN_ABI_VERSION 4u  // 2: MotionPrior::twistEnergySigma; 3: DiagnosticProbe::evaluate(ProbeInput);
-                                     // 4: ShutterModel::estimatesLineDelay
+#define RSVIO_PLUGIN_ABI_VERSION 5u  // 2: MotionPrior::twistEnergySigma; 3: DiagnosticProbe::evaluate(ProbeInput);
+                                     // 4: ShutterModel::estimatesLineDelay; 5: DataSource::imuReader
 #define RSVIO_PLUGIN_API_VERSION 1u
 
 extern "C" {

@@ -13,6 +13,7 @@
 //   states.png, residual_row_time.png and residual_image.png (when diagnostics.bin is there).
 // - Files of a comparison: <out>/figures/compare_grid.png, ate_per_config.png, <out>/index.html.
 #pragma once
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,8 +53,11 @@ RenderStatus renderRunFolder(const std::string& run_dir, const RenderOptions& op
 // states.csv was not estimated (a visual-odometry run has no velocity or biases; a global shutter may
 // have no twist) and gets no panel: its title goes to *not_estimated instead. Scale gets a panel only
 // when has_scale (report.json has a scale, as the run page shows it; visual odometry has none).
+// dynamic_marginalization: report.json extra.vio.dynamic_marginalization when the run had it; the scale
+// panel then also draws the interval [centre / d, centre * d] over time, so its switches show.
 std::vector<Panel> keyframeStatePanels(const std::vector<StateRow>& rows, bool has_scale,
-                                       std::vector<std::string>* not_estimated = nullptr);
+                                       std::vector<std::string>* not_estimated = nullptr,
+                                       const nlohmann::json* dynamic_marginalization = nullptr);
 
 // Mean-residual maps' input from a diagnostics log (every observation; weights kept).
 ResidualMapInput residualMapInput(const DiagnosticsLog& log);
