@@ -51,7 +51,6 @@ class ImuCsvStream {
   ImuCsvStream(const std::string& csv_path, std::vector<std::string>* warnings);
   bool next(ImuSample& s);              // the next kept sample; false at the end; throws DataError
   long line() const { return line_; }   // data.csv line of the sample next() returned last
-  const std::string& path() const { return csv_.path(); }
 
  private:
   std::vector<std::string> dropped_;    // warnings when the caller wants none
@@ -65,7 +64,7 @@ class ImuCsvStream {
 
 // Checks the gaps between consecutive IMU samples, fed in order, against max_gap_ns: a gap overlapping
 // [t_begin_ns, t_end_ns] (the camera's span on the IMU clock) throws DataError, others become warnings
-// (appended on finish()).
+// (the first few as they come, then a count on finish()).
 class ImuGapCheck {
  public:
   ImuGapCheck(std::string csv_path, int64_t max_gap_ns, int64_t t_begin_ns, int64_t t_end_ns,
@@ -83,7 +82,6 @@ class ImuGapCheck {
   long prev_line_ = 0;
   bool any_ = false;
 };
-
 
 // "1403636579.763555584 s" from ns, exactly.
 std::string formatStamp(int64_t t_ns);
