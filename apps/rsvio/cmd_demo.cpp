@@ -2,7 +2,7 @@
 //   1. simulate configs/sim/demo.json (a rolling shutter hidden from the calibration) into <out>/data,
 //      or reuse <out>/data when it was simulated before from the same effective config and seed
 //      (written to <out>/data.partial and renamed when complete, so a half-written dataset is never reused),
-//   2. run the default model configs/gs_vo.json on it (evaluated against the ground truth) and render,
+//   2. run the default model configs/default.json on it (evaluated against the ground truth) and render,
 //   3. diagnose the run from its folder alone (rsvio diagnose): verdict, ranking, the line to add,
 //   4. run again with the named line (when there is one) and render,
 //   5. compare (rsvio diagnose --against): ATE before and after, is the evidence gone,
@@ -21,6 +21,9 @@
 #include "render_hook.h"
 #include "run_summary.h"
 #include "rsvio/core/error.h"
+#include "rsvio/core/time.h"
+#include "rsvio/eval/evaluate_files.h"
+#include "rsvio/io/trajectory.h"
 #include "rsvio/pipeline/run.h"
 #include "rsvio/plugin/host.h"
 #include "rsvio/sim/simulator.h"
@@ -118,16 +121,54 @@ std::string ateText(const Report& rep) {
   return rep.ok() ? std::string(b) : std::string(b) + " (run failed: " + rep.error + ")";
 }
 
+// When the default model is lost part way, its ATE covers only the frames it tracked and the run with
+// the named line covers the whole sequence: not comparable. Both are evaluated again over the span the
+// first one tracked (its first to last trajectory stamp), Sim(3)-aligned alike (the first run may have
+// stayed visual, without metric scale), from the trajectory.tum each wrote. The cut trajectory is
+// written to <out>/<after>_over_<before>_span.tum. Returns "" when there is nothing to say.
+std::string commonSpanText(const std::string& data, const std::string& before_dir, const std::string& after_dir,
+                           const std::string& out) {
+  const fs::path tb = fs::path(before_dir) / "trajectory.tum", ta = fs::path(after_dir) / "trajectory.tum";
+  if (!fs::exists(tb) || !fs::exists(ta)) return "";
+  try {
+    const io::Trajectory before = io::readTum(tb.string());
+    io::Trajectory after = io::readTum(ta.string());
+    if (before.size() < 3 || after.size() <= before.size()) return "";
+    const int64_t t0 = before.poses.front().t_ns, t1 = before.poses.back().t_ns;
+    std::vector<io::StampedPose> cut;
+    for (const auto& p : after.poses)
+      if (p.t_ns >= t0 && p.t_ns <= t1) cut.push_back(p);
+    after.poses = cut;
+    const fs::path cut_path = fs::path(out) / (fs::path(after_dir).filename().string() + "_over_" +
+                                               fs::path(before_dir).filename().string() + "_span.tum");
+    io::writeTum(cut_path.string(), after);
+    auto ate = [&](const std::string& est) {
+      eval::FileEvalRequest q;
+      q.dataset_dir = data;
+      q.est_path = est;
+      q.align = eval::AlignMode::kSim3;
+      return eval::evaluateFiles(q).result.ate_m.rmse;
+    };
+    const double a_b = ate(tb.string()), a_a = ate(cut_path.string());
+    char b[256];
+    std::snprintf(b, sizeof b, "ATE over the span the default model tracked (%zu poses, %.2f s, Sim(3)): before %.4f m, after %.4f m",
+                  before.size(), nsToS(t1 - t0), a_b, a_a);
+    return b;
+  } catch (const std::exception& e) {
+    return std::string("ATE over the common span: not computed (") + e.what() + ")";
+  }
+}
+
 int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
   const std::string cfg_dir = configDir();
   const std::string sim_cfg = (fs::path(cfg_dir) / "sim" / "demo.json").string();
-  const std::string run_cfg = (fs::path(cfg_dir) / "gs_vo.json").string();
+  const std::string run_cfg = (fs::path(cfg_dir) / "default.json").string();
   for (const auto& p : {sim_cfg, run_cfg})
     if (!fs::exists(p)) throw Error(p + ": demo config not found (set RSVIO_CONFIG_DIR to rsvio's configs/ folder)");
   PluginHost host(PluginHost::defaultSearchPath(g.plugin_path));
   const std::string data = (fs::path(out) / "data").string();
-  const std::string before_dir = (fs::path(out) / "gs_vo").string();
-  const std::string after_dir = (fs::path(out) / "gs_vo_fixed").string();
+  const std::string before_dir = (fs::path(out) / "default").string();
+  const std::string after_dir = (fs::path(out) / "default_fixed").string();
 
   std::printf("rsvio demo: 1/5 simulating %s into %s\n", sim_cfg.c_str(), data.c_str());
   std::fflush(stdout);
@@ -183,6 +224,8 @@ int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
   std::printf("ATE before (default model): %s\n", ateText(rb).c_str());
   if (ran_after) {
     std::printf("ATE after  (with the line): %s\n", ateText(after.report).c_str());
+    const std::string common = commonSpanText(data, before_dir, after_dir, out);
+    if (!common.empty()) std::printf("%s\n", common.c_str());
     if (cmp.contains("against") && cmp["against"].contains("evidence_gone"))
       std::printf("evidence of %s after the change: %s\n", verdict.c_str(),
                   cmp["against"]["evidence_gone"].get<bool>() ? "gone" : "still there");

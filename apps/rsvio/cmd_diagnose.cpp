@@ -463,7 +463,10 @@ std::string formatDiagnosis(const nlohmann::json& d) {
       << ", ATE " << (c.contains("ate_before_m") ? fmt(c["ate_before_m"].get<double>(), 4) + " m" : "n/a")
       << "; after " << c["after"]["status"].get<std::string>() << ", ATE "
       << (c.contains("ate_after_m") ? fmt(c["ate_after_m"].get<double>(), 4) + " m" : "n/a");
-    if (c.contains("ate_ratio")) o << " (" << fmt(c["ate_ratio"].get<double>()) << "x lower)";
+    if (c.contains("ate_ratio")) {
+      const double r = c["ate_ratio"].get<double>();  // before / after
+      o << " (" << (r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher") << ")";
+    }
     o << "\n";
     for (const auto& e : c["evidence"]) {
       o << "  evidence " << e["effect"].get<std::string>() << ": " << fmt(e["statistic_before"].get<double>()) << " -> "

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
 #include <cstdlib>
 #include <sstream>
 #include <thread>
@@ -56,6 +57,14 @@ void killAndReap(pid_t pid) {
 }
 
 }  // namespace
+
+// The pid in /tmp/.X<n>-lock (Xvfb writes it as text when it claims display n), -1 if none.
+static long lockPid(int n) {
+  std::ifstream in("/tmp/.X" + std::to_string(n) + "-lock");
+  long pid = -1;
+  if (!(in >> pid)) return -1;
+  return pid;
+}
 
 bool canOpenDisplay(const std::string& display) {
   if (display.empty()) return false;
@@ -131,6 +140,14 @@ bool DisplayGuard::tryStart(const std::string& xvfb_path, int n, const DisplayGu
       return false;
     }
     if (pathExists(socket) && canOpenDisplay(disp)) {
+      // Two processes can pick the same free number at once (parallel tests, batch renders): the
+      // display that opens may be the other's, whose Xvfb goes when that process ends. Ours only if the
+      // X lock file holds our child's pid (Xvfb writes it there when it claims the number).
+      if (lockPid(n) != pid) {
+        killAndReap(pid);
+        why = "display " + disp + " was claimed by another process's Xvfb";
+        return false;
+      }
       xvfb_pid_ = pid;
       display_ = disp;
       ::setenv("DISPLAY", disp.c_str(), 1);

@@ -247,7 +247,9 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
     // IMU samples are streamed from the dataset, not held: memory stays flat on long recordings.
     std::unique_ptr<ImuReader> imu = sensors.has_imu ? source->imuReader() : nullptr;
     ImuSample imu_next;
-    bool imu_pending = imu && imu->next(imu_next);
+    // The first sample is read inside the loop's guard, like every other, so a file that changed since
+    // open() fails the run with report.json written, not the process.
+    bool imu_pending = static_cast<bool>(imu), imu_primed = false;
     const size_t n = source->numFrames();
     // IMU samples up to half a frame past the frame's time on the IMU clock (more is harmless).
     const double offset_s = inertialOptionsFromConfig(cfg).assumedTimeOffsetS(sensors.camera);
@@ -266,6 +268,10 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
       const int64_t t_f = source->frameTime(i);
       Frame frame;
       try {
+        if (!imu_primed) {
+          imu_pending = imu_pending && imu->next(imu_next);
+          imu_primed = true;
+        }
         while (imu_pending && imu_next.t_ns <= t_f + lookahead_ns) {
           odo.addImu(imu_next);
           imu_pending = imu->next(imu_next);

@@ -42,6 +42,12 @@ struct ImuMotionOptions {
   double buffer_s = 20.0;                // IMU history kept (covers the keyframe window's twist priors)
   double max_extrapolation_ms = 5.0;     // a camera stamp this far past the last IMU sample holds it
   bool recovery = true;                  // append constant-velocity and no-motion guesses
+  // The window's smooth-motion prior on the rolling-shutter twists (backend/smooth_motion_term.h, as
+  // motion.constant_velocity's twist_info_*), non-metric: per (W_f unit / s)^2 and (s / rad)^2. It holds
+  // the twists before the visual-inertial initialisation, when the IMU twist energy has no scale yet,
+  // and stays beside it after. Inert with a global shutter. 0 and 0: none.
+  double smooth_twist_info_trans = 1e5;
+  double smooth_twist_info_rot = 1e5;
 };
 
 class ImuMotionPrior : public MotionPrior {
@@ -116,6 +122,15 @@ class ImuMotionPrior : public MotionPrior {
   bool twistEnergySigma(double* sigma_trans_m_s, double* sigma_rot_rad_s) const override {
     *sigma_trans_m_s = o_.twist_sigma_trans_m_s;
     *sigma_rot_rad_s = o_.twist_sigma_rot_rad_s;
+    return true;
+  }
+
+  bool smoothMotionInformation(Mat6* information) const override {
+    if (!(o_.smooth_twist_info_trans > 0.0 || o_.smooth_twist_info_rot > 0.0)) return false;
+    if (information) {
+      information->setZero();
+      information->diagonal() << Vec3::Constant(o_.smooth_twist_info_trans), Vec3::Constant(o_.smooth_twist_info_rot);
+    }
     return true;
   }
 

@@ -18,6 +18,10 @@ ParamTable table() {
       paramDouble("max_extrapolation_ms", d.max_extrapolation_ms, 0.0, 100.0, "ms",
                   "a camera time this far past the last IMU sample uses that sample"),
       paramBool("recovery", d.recovery, "append the constant-velocity and no-motion guesses after the IMU's"),
+      paramDouble("smooth_twist_info_trans", d.smooth_twist_info_trans, 0.0, 1e12, "s^2/unit^2",
+                  "information of the window's smooth-motion prior on rolling-shutter twists, translation (0: none)"),
+      paramDouble("smooth_twist_info_rot", d.smooth_twist_info_rot, 0.0, 1e12, "s^2/rad^2",
+                  "information of the window's smooth-motion prior on rolling-shutter twists, rotation"),
   };
 }
 
@@ -32,6 +36,8 @@ void registerAll(PluginRegistrar& r) {
                        o.buffer_s = p.getDouble("buffer_s");
                        o.max_extrapolation_ms = p.getDouble("max_extrapolation_ms");
                        o.recovery = p.getBool("recovery");
+                       o.smooth_twist_info_trans = p.getDouble("smooth_twist_info_trans");
+                       o.smooth_twist_info_rot = p.getDouble("smooth_twist_info_rot");
                        return std::make_unique<ImuMotionPrior>(o);
                      });
 }

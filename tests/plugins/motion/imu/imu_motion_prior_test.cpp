@@ -131,5 +131,32 @@ TEST(ImuMotionPrior, LoadsThroughTheHostWithItsParamTable) {
   EXPECT_EQ(problems.size(), 1u);
 }
 
+// The window's smooth-motion prior on rolling-shutter twists: on by default (a rolling shutter added to
+// a visual-inertial config holds its twists before the initialisation without a second motion slot),
+// its information from the params, none with both weights 0.
+TEST(ImuMotionPrior, HandsTheSmoothMotionInformationToTheBackEnd) {
+  Mat6 info;
+  ASSERT_TRUE(ImuMotionPrior().smoothMotionInformation(&info));
+  EXPECT_DOUBLE_EQ(info(0, 0), 1e5);
+  EXPECT_DOUBLE_EQ(info(5, 5), 1e5);
+  ImuMotionOptions o;
+  o.smooth_twist_info_trans = 10.0;
+  o.smooth_twist_info_rot = 100.0;
+  ASSERT_TRUE(ImuMotionPrior(o).smoothMotionInformation(&info));
+  EXPECT_DOUBLE_EQ(info(2, 2), 10.0);
+  EXPECT_DOUBLE_EQ(info(3, 3), 100.0);
+  EXPECT_DOUBLE_EQ(info(0, 3), 0.0);
+  o.smooth_twist_info_trans = o.smooth_twist_info_rot = 0.0;
+  EXPECT_FALSE(ImuMotionPrior(o).smoothMotionInformation(&info));
+  PluginHost host({RSVIO_PLUGIN_DIR});
+  std::vector<ConfigProblem> problems;
+  const auto params = validateParams(nlohmann::json{{"smooth_twist_info_rot", 7.0}}, host.info("motion.imu").params,
+                                     "motion.imu.params", problems);
+  ASSERT_TRUE(problems.empty());
+  ASSERT_TRUE(host.create<MotionPrior>("motion.imu", Params(params))->smoothMotionInformation(&info));
+  EXPECT_DOUBLE_EQ(info(0, 0), 1e5);
+  EXPECT_DOUBLE_EQ(info(4, 4), 7.0);
+}
+
 }  // namespace
 }  // namespace rsvio
