@@ -6,6 +6,8 @@
 # file, so what grows with the sequence shows (the diagnostics log and per-frame records are expected
 # to). Usage: scripts/bench_memory.sh [build-dir] [work-dir]   (defaults: build, /tmp/rsvio_bench_memory)
 # TAG=name names the runs (run_<name>_<dur>s), so two builds can be compared on the same simulated data.
+# SEED (simulator seed, default 1), SPEED (m/s, default 0.45) and ROT_SPEED (deg/s, default 35) set the
+# sequences (the same for both lengths); the data folder's name carries them.
 # Figures: docs/backend.md, "Memory on long runs".
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,12 +27,15 @@ r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PI
 sys.stderr.write(r.stderr.decode()[-2000:] if r.returncode else "")
 print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, r.returncode)' "$@"
 }
+SEED=${SEED:-1}
+SPEED=${SPEED:-0.45}
+ROT_SPEED=${ROT_SPEED:-35}
 for dur in "$SHORT_S" "$LONG_S"; do
-  data="$WORK/data_${dur}s"
+  data="$WORK/data_s${SEED}_v${SPEED}_w${ROT_SPEED}_${dur}s"
   if [ ! -f "$data/truth.json" ]; then
     echo "simulating ${dur} s ..."
     "$BIN" -q simulate --config "$ROOT/configs/sim/tiny_gs.json" --out "$data" --set motion.duration_s="$dur" \
-      --set camera.supersampling=1 --set motion.mean_speed_m_s=0.45 --set motion.mean_rot_speed_deg_s=35 \
+      --set camera.supersampling=1 --set motion.mean_speed_m_s="$SPEED" --set motion.mean_rot_speed_deg_s="$ROT_SPEED" --seed "$SEED" \
       --set motion.mean_accel_m_s2=1.1 --set motion.mean_rot_accel_deg_s2=130
   fi
   echo "running gs_vo on ${dur} s ..."

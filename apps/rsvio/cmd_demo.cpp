@@ -1,6 +1,6 @@
-// rsvio demo [--out DIR] [--fresh]: the main job on a built-in synthetic sequence.
-//   1. simulate configs/sim/demo.json (a rolling shutter hidden from the calibration) into <out>/data,
-//      or reuse <out>/data when it was simulated before from the same effective config and seed
+// rsvio demo [--out DIR] [--reuse-data]: the main job on a built-in synthetic sequence.
+//   1. simulate configs/sim/demo.json (a rolling shutter hidden from the calibration) afresh into <out>/data,
+//      or with --reuse-data reuse <out>/data when it was simulated before from the same effective config and seed
 //      (written to <out>/data.partial and renamed when complete, so a half-written dataset is never reused),
 //   2. run the default model configs/default.json on it (evaluated against the ground truth) and render,
 //   3. diagnose the run from its folder alone (rsvio diagnose): verdict, ranking, the line to add,
@@ -174,7 +174,7 @@ int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
   std::fflush(stdout);
   const auto t0 = std::chrono::steady_clock::now();
   if (prepareData(sim_cfg, data, fresh, host))
-    std::printf("  reusing the dataset simulated before from the same config and seed (--fresh simulates again)\n");
+    std::printf("  reusing the dataset simulated before from the same config and seed (--reuse-data)\n");
   else
     std::printf("  simulated in %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 
@@ -249,10 +249,11 @@ int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
 void addDemoCommand(CLI::App& root, const GlobalOptions& g, CommandResult& r) {
   auto* sub = root.add_subcommand("demo", "the main job on a built-in synthetic sequence");
   static std::string out = "out/demo";
-  static bool fresh = false;
+  static bool reuse = false;
   sub->add_option("--out", out, "output folder")->capture_default_str();
-  sub->add_flag("--fresh", fresh, "simulate the sequence again even when <out>/data holds it already");
-  sub->callback([&g, &r] { r.exit_code = runDemo(out, fresh, g); });
+  sub->add_flag("--reuse-data", reuse,
+                "reuse <out>/data when it was simulated from the same config and seed (default: simulate afresh)");
+  sub->callback([&g, &r] { r.exit_code = runDemo(out, !reuse, g); });
 }
 
 }  // namespace rsvio::app
