@@ -62,6 +62,11 @@ ParamTable backendParamTable() {
       paramDouble("init_min_inlier_ratio", d.init_min_inlier_ratio, 0.0, 1.0, "",
                   "share of corner tracks consistent with the essential matrix"),
       paramInt("init_corners", d.init_corners, 20, 10000, "", "corners tracked during initialisation"),
+      paramInt("init_rolling_shutter_iterations", d.init_rolling_shutter_iterations, 0, 20, "",
+               "rolling shutter: rounds of the two-view start that move each corner to its image's central pose "
+               "(0: the start ignores the readout)"),
+      paramBool("init_keyframe_twist", d.init_keyframe_twist,
+                "rolling shutter: the first keyframe starts with the two-view start's twist (else 0)"),
       paramInt("max_lost_frames", d.max_lost_frames, 0, 1000, "",
                "consecutive frames the tracker may lose before the run fails"),
       paramDouble("fail_max_rmse", d.fail_max_rmse, 0.0, 1e6, "intensity",
@@ -105,6 +110,8 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.init_min_parallax_deg = p.getDouble("init_min_parallax_deg");
   o.init_min_inlier_ratio = p.getDouble("init_min_inlier_ratio");
   o.init_corners = static_cast<int>(p.getInt("init_corners"));
+  o.init_rolling_shutter_iterations = static_cast<int>(p.getInt("init_rolling_shutter_iterations"));
+  o.init_keyframe_twist = p.getBool("init_keyframe_twist");
   o.max_lost_frames = static_cast<int>(p.getInt("max_lost_frames"));
   o.fail_max_rmse = p.getDouble("fail_max_rmse");
   o.fail_min_inlier_ratio = p.getDouble("fail_min_inlier_ratio");

@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "rsvio/core/time.h"
 #include "rsvio/interfaces/camera.h"
 
 namespace rsvio {
@@ -162,10 +163,10 @@ bool triangulate(const Mat3d& R, const Eigen::Vector3d& t, const Eigen::Vector3d
 
 }  // namespace
 
-MonoInitializer::MonoInitializer(const BackendOptions& options, const CameraModel& camera)
-    : options_(options), camera_(camera) {}
+MonoInitializer::MonoInitializer(const BackendOptions& options, const CameraModel& camera, const RowTiming& timing)
+    : options_(options), camera_(camera), timing_(timing) {}
 
-void MonoInitializer::reset(int64_t frame_index) {
+void MonoInitializer::reset(int64_t frame_index, int64_t t_ns) {
   const ImageLevel& l0 = prev_->level(0);
   cv::Mat img8(l0.height(), l0.width(), CV_8U);
   for (int y = 0; y < l0.height(); ++y)
@@ -181,13 +182,15 @@ void MonoInitializer::reset(int64_t frame_index) {
   cur_pts_ = corners;
   initial_tracks_ = static_cast<int>(corners.size());
   ref_index_ = frame_index;
+  ref_t_ns_ = t_ns;
   frames_since_ref_ = 0;
 }
 
-bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int64_t frame_index) {
+bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int64_t frame_index, int64_t t_ns) {
+  cur_t_ns_ = t_ns;
   if (!prev_ || ref_index_ < 0) {
     prev_ = std::move(pyramid);
-    reset(frame_index);
+    reset(frame_index, t_ns);
     status_ = "reference frame set (" + std::to_string(initial_tracks_) + " corners)";
     return false;
   }
@@ -207,7 +210,7 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
   ++frames_since_ref_;
   if (static_cast<int>(cur_pts_.size()) < std::max(30, initial_tracks_ / 3)) {
     status_ = "lost corner tracks (" + std::to_string(cur_pts_.size()) + "), new reference";
-    reset(frame_index);
+    reset(frame_index, t_ns);
     return false;
   }
   if (frames_since_ref_ < options_.init_min_frames) {
@@ -228,34 +231,150 @@ bool MonoInitializer::tryInitialise() {
     status_ = os.str();
     return false;
   }
+  std::vector<Vec2> ref_px, cur_px;
+  for (size_t i = 0; i < cur_pts_.size(); ++i) {
+    ref_px.emplace_back(ref_pts_[i].x, ref_pts_[i].y);
+    cur_px.emplace_back(cur_pts_[i].x, cur_pts_[i].y);
+  }
+  TwoViewOptions tvo;
+  tvo.rolling_shutter_iterations = options_.init_rolling_shutter_iterations;
+  const TwoViewResult r = solveTwoView(ref_px, cur_px, camera_, timing_, nsToS(cur_t_ns_ - ref_t_ns_),
+                                       0x5eed1234u + static_cast<uint64_t>(ref_index_), tvo);
+  status_ = r.status;
+  parallax_deg_ = r.parallax_deg;
+  if (!r.found) return false;
+  if (r.inlier_ratio < options_.init_min_inlier_ratio || r.front < 0.9 * static_cast<double>(r.inliers) ||
+      parallax_deg_ < options_.init_min_parallax_deg || r.num_depths < 10)
+    return false;
+  T_cur_ref_ = r.T_cur_ref;
+  xi_ = r.xi;
+  return true;
+}
+
+namespace {
+
+// One essential-matrix fit from the inlier set `in` (refit twice, re-selecting inliers), its
+// decomposition (the one of four with most points in front of both cameras), and the depths of every
+// correspondence along its ray in both cameras (NaN where the rays do not meet in front).
+struct EssentialFit {
+  Mat3d R;
+  Eigen::Vector3d t;  // unit length
+  std::vector<int> in;
+  int front = -1;
+  std::vector<double> d1, d2;  // per correspondence
+  std::vector<double> angle;   // per inlier in front
+};
+
+EssentialFit fitEssential(const std::vector<Eigen::Vector2d>& x1, const std::vector<Eigen::Vector2d>& x2,
+                          const std::vector<Eigen::Vector3d>& B1, const std::vector<Eigen::Vector3d>& B2,
+                          std::vector<int> in, double thr) {
+  const int m = static_cast<int>(x1.size());
+  EssentialFit f;
+  Mat3d E = eightPoint(x1, x2, in);
+  for (int rep = 0; rep < 2; ++rep) {
+    std::vector<int> sel;
+    for (int i = 0; i < m; ++i)
+      if (sampson(E, x1[static_cast<size_t>(i)], x2[static_cast<size_t>(i)]) < thr) sel.push_back(i);
+    if (sel.size() < 8) break;
+    in.swap(sel);
+    E = eightPoint(x1, x2, in);
+  }
+  f.in = in;
+  Eigen::JacobiSVD<Mat3d> svd(E, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3d U = svd.matrixU(), V = svd.matrixV();
+  if (U.determinant() < 0) U = -U;
+  if (V.determinant() < 0) V = -V;
+  Mat3d Wm;
+  Wm << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  const Mat3d Rs[2] = {U * Wm * V.transpose(), U * Wm.transpose() * V.transpose()};
+  for (const Mat3d& R : Rs)
+    for (double sgn : {1.0, -1.0}) {
+      const Eigen::Vector3d t = sgn * U.col(2);
+      int front = 0;
+      std::vector<double> angle;
+      for (int i : in) {
+        double d1 = 0, d2 = 0;
+        if (!triangulate(R, t, B1[static_cast<size_t>(i)], B2[static_cast<size_t>(i)], &d1, &d2)) continue;
+        if (d1 > 0 && d2 > 0) {
+          ++front;
+          angle.push_back(std::acos(std::clamp(B1[static_cast<size_t>(i)].dot(R.transpose() * B2[static_cast<size_t>(i)]), -1.0, 1.0)));
+        }
+      }
+      if (front > f.front) {
+        f.front = front;
+        f.R = R;
+        f.t = t;
+        f.angle = angle;
+      }
+    }
+  const double nan = std::nan("");
+  f.d1.assign(static_cast<size_t>(m), nan);
+  f.d2.assign(static_cast<size_t>(m), nan);
+  for (int i = 0; i < m; ++i) {
+    double d1 = 0, d2 = 0;
+    if (triangulate(f.R, f.t, B1[static_cast<size_t>(i)], B2[static_cast<size_t>(i)], &d1, &d2) && d1 > 0 && d2 > 0) {
+      f.d1[static_cast<size_t>(i)] = d1;
+      f.d2[static_cast<size_t>(i)] = d2;
+    }
+  }
+  return f;
+}
+
+// A bearing seen at row time tau of a frame moving with twist xi, moved to the frame's central pose:
+// P(tau) = exp(xi tau) P(0) (shutter.h), so P(0) = exp(-xi tau) P(tau). With the depth unknown (NaN)
+// the ray's direction at infinity: the rotation alone.
+Eigen::Vector3d toCentralPose(const Eigen::Vector3d& b, double depth, const Vec6& xi, double tau) {
+  const SE3d M = SE3d::exp(-xi * tau);
+  if (std::isfinite(depth)) return (M * (depth * b)).normalized();
+  return (M.so3() * b).normalized();
+}
+
+}  // namespace
+
+TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Vec2>& cur_px, const CameraModel& camera,
+                           const RowTiming& timing, double dt_s, uint64_t seed, const TwoViewOptions& options) {
+  TwoViewResult r;
   // Unit-focal image-plane coordinates through the camera's own unprojection.
-  const Eigen::Index n = static_cast<Eigen::Index>(cur_pts_.size());
+  const Eigen::Index n = static_cast<Eigen::Index>(std::min(ref_px.size(), cur_px.size()));
   Eigen::Matrix2Xd u1(2, n), u2(2, n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    u1.col(i) << ref_pts_[static_cast<size_t>(i)].x, ref_pts_[static_cast<size_t>(i)].y;
-    u2.col(i) << cur_pts_[static_cast<size_t>(i)].x, cur_pts_[static_cast<size_t>(i)].y;
+    u1.col(i) = ref_px[static_cast<size_t>(i)];
+    u2.col(i) = cur_px[static_cast<size_t>(i)];
   }
   Eigen::Matrix3Xd b1, b2;
   std::vector<uint8_t> v1, v2;
-  camera_.unproject(u1, b1, v1);
-  camera_.unproject(u2, b2, v2);
+  camera.unproject(u1, b1, v1);
+  camera.unproject(u2, b2, v2);
   std::vector<Eigen::Vector2d> x1, x2;
-  std::vector<Eigen::Vector3d> B1, B2;
+  std::vector<Eigen::Vector3d> R1, R2;  // raw bearings, as observed at their rows
+  std::vector<double> tau1, tau2;       // row times relative to each image's timestamp
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!v1[static_cast<size_t>(i)] || !v2[static_cast<size_t>(i)] || b1(2, i) < 0.1 || b2(2, i) < 0.1) continue;
-    x1.emplace_back(b1(0, i) / b1(2, i), b1(1, i) / b1(2, i));
+    x1.emplace_back(b1(0, i) / b1(2, i), b1(1, i) / b1(2, i));  // the unit-focal plane, as observed
     x2.emplace_back(b2(0, i) / b2(2, i), b2(1, i) / b2(2, i));
-    B1.push_back(b1.col(i).normalized());
-    B2.push_back(b2.col(i).normalized());
+    R1.push_back(b1.col(i).normalized());
+    R2.push_back(b2.col(i).normalized());
+    tau1.push_back(timing.rowTime(u1(1, i)));
+    tau2.push_back(timing.rowTime(u2(1, i)));
   }
-  const int m = static_cast<int>(x1.size());
+  const int m = static_cast<int>(R1.size());
+  r.correspondences = m;
   if (m < 20) {
-    status_ = "too few corners for the essential matrix";
-    return false;
+    r.status = "too few corners for the essential matrix";
+    return r;
   }
-  const double f = camera_.calibration().intrinsics[0] > 0 ? camera_.calibration().intrinsics[0] : 500.0;
+  std::vector<Eigen::Vector3d> B1 = R1, B2 = R2;
+  auto toPlane = [&]() {
+    x1.resize(static_cast<size_t>(m));
+    x2.resize(static_cast<size_t>(m));
+    for (size_t i = 0; i < static_cast<size_t>(m); ++i) {
+      x1[i] = B1[i].head<2>() / B1[i].z();
+      x2[i] = B2[i].head<2>() / B2[i].z();
+    }
+  };
+  const double f = camera.calibration().intrinsics[0] > 0 ? camera.calibration().intrinsics[0] : 500.0;
   const double thr = (1.0 / f) * (1.0 / f);
-  std::mt19937_64 rng(0x5eed1234u + static_cast<uint64_t>(ref_index_));
+  std::mt19937_64 rng(seed);
   std::vector<int> best_in;
   std::vector<int> sample(8);
   for (int it = 0; it < kRansacIterations; ++it) {
@@ -273,66 +392,45 @@ bool MonoInitializer::tryInitialise() {
     if (in.size() > best_in.size()) best_in.swap(in);
   }
   if (best_in.size() < 8) {
-    status_ = "no essential matrix";
-    return false;
+    r.status = "no essential matrix";
+    return r;
   }
-  // Refit on the inliers (twice, re-selecting inliers).
-  Mat3d E = eightPoint(x1, x2, best_in);
-  for (int rep = 0; rep < 2; ++rep) {
-    std::vector<int> in;
-    for (int i = 0; i < m; ++i)
-      if (sampson(E, x1[static_cast<size_t>(i)], x2[static_cast<size_t>(i)]) < thr) in.push_back(i);
-    if (in.size() < 8) break;
-    best_in.swap(in);
-    E = eightPoint(x1, x2, best_in);
-  }
-  const double inlier_ratio = static_cast<double>(best_in.size()) / m;
-  // The four decompositions; the one with most points in front of both cameras.
-  Eigen::JacobiSVD<Mat3d> svd(E, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Mat3d U = svd.matrixU(), V = svd.matrixV();
-  if (U.determinant() < 0) U = -U;
-  if (V.determinant() < 0) V = -V;
-  Mat3d Wm;
-  Wm << 0, -1, 0, 1, 0, 0, 0, 0, 1;
-  const Mat3d Rs[2] = {U * Wm * V.transpose(), U * Wm.transpose() * V.transpose()};
-  int best_front = -1;
-  Mat3d R_best;
-  Eigen::Vector3d t_best;
-  std::vector<double> depth_best, angle_best;
-  for (const Mat3d& R : Rs)
-    for (double sgn : {1.0, -1.0}) {
-      const Eigen::Vector3d t = sgn * U.col(2);
-      int front = 0;
-      std::vector<double> depth, angle;
-      for (int i : best_in) {
-        double d1 = 0, d2 = 0;
-        if (!triangulate(R, t, B1[static_cast<size_t>(i)], B2[static_cast<size_t>(i)], &d1, &d2)) continue;
-        if (d1 > 0 && d2 > 0) {
-          ++front;
-          depth.push_back(d1);
-          angle.push_back(std::acos(std::clamp(B1[static_cast<size_t>(i)].dot(R.transpose() * B2[static_cast<size_t>(i)]), -1.0, 1.0)));
-        }
-      }
-      if (front > best_front) {
-        best_front = front;
-        R_best = R;
-        t_best = t;
-        depth_best = depth;
-        angle_best = angle;
-      }
+  EssentialFit fit = fitEssential(x1, x2, B1, B2, best_in, thr);
+  // Rolling shutter: each corner was seen at its own row's time. With the motion of the fit taken as a
+  // constant twist between the two timestamps (xi = log(T_cur_ref) / dt, per second, in the units of
+  // the unit baseline), every bearing is moved to its frame's central pose through its triangulated
+  // depth, and the essential matrix is fitted again from the current inliers. A global shutter (or a
+  // line delay of 0) skips this: every row time is 0.
+  Vec6 xi = Vec6::Zero();
+  const bool rolling = timing.dtDv() != 0.0 && dt_s > 0.0;
+  for (int k = 0; rolling && k < options.rolling_shutter_iterations; ++k) {
+    xi = SE3d(fit.R, fit.t).log() / dt_s;
+    for (size_t i = 0; i < static_cast<size_t>(m); ++i) {
+      B1[i] = toCentralPose(R1[i], fit.d1[i], xi, tau1[i]);
+      B2[i] = toCentralPose(R2[i], fit.d2[i], xi, tau2[i]);
     }
-  parallax_deg_ = median(angle_best) * 180.0 / M_PI;
+    toPlane();
+    fit = fitEssential(x1, x2, B1, B2, fit.in, thr);
+  }
+  r.inliers = static_cast<int>(fit.in.size());
+  r.inlier_ratio = static_cast<double>(fit.in.size()) / m;
+  r.front = fit.front;
+  r.parallax_deg = median(fit.angle) * 180.0 / M_PI;
   std::ostringstream os;
-  os << "essential matrix: " << best_in.size() << "/" << m << " inliers, " << best_front << " in front, median parallax "
-     << parallax_deg_ << " deg";
-  status_ = os.str();
-  if (inlier_ratio < options_.init_min_inlier_ratio || best_front < 0.9 * static_cast<double>(best_in.size()) ||
-      parallax_deg_ < options_.init_min_parallax_deg || depth_best.size() < 10)
-    return false;
-  const double med_depth = median(depth_best);
-  if (!(med_depth > 0)) return false;
-  T_cur_ref_ = SE3d(Eigen::Quaterniond(R_best).normalized(), t_best / med_depth);
-  return true;
+  os << "essential matrix: " << fit.in.size() << "/" << m << " inliers, " << fit.front << " in front, median parallax "
+     << r.parallax_deg << " deg";
+  if (rolling) os << ", rolling shutter corrected";
+  r.status = os.str();
+  std::vector<double> depth;
+  for (int i : fit.in)
+    if (std::isfinite(fit.d1[static_cast<size_t>(i)])) depth.push_back(fit.d1[static_cast<size_t>(i)]);
+  r.num_depths = static_cast<int>(depth.size());
+  const double med_depth = median(depth);
+  if (depth.empty() || !(med_depth > 0)) return r;
+  r.T_cur_ref = SE3d(Eigen::Quaterniond(fit.R).normalized(), fit.t / med_depth);
+  if (rolling && dt_s > 0) r.xi = r.T_cur_ref.log() / dt_s;
+  r.found = true;
+  return r;
 }
 
 }  // namespace rsvio

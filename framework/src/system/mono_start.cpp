@@ -3,11 +3,12 @@
 
 namespace rsvio {
 
-MonoStart::MonoStart(const BackendOptions& options, const CameraModel& camera) : initializer_(options, camera) {}
+MonoStart::MonoStart(const BackendOptions& options, const CameraModel& camera, const RowTiming& timing)
+    : initializer_(options, camera, timing) {}
 
 bool MonoStart::addFrame(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr, const cv::Mat& working) {
   const int64_t ref_before = initializer_.referenceIndex();
-  const bool done = initializer_.addFrame(pyr, frame.index);
+  const bool done = initializer_.addFrame(pyr, frame.index, frame.t_ns);
   if (initializer_.referenceIndex() != ref_before) frames_.clear();  // new reference: older frames are lost
   StartFrame f;
   f.index = frame.index;

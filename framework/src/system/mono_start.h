@@ -38,13 +38,14 @@ class MonoStart {
     cv::Mat working;                              // the frames in between only
   };
 
-  MonoStart(const BackendOptions& options, const CameraModel& camera);
+  MonoStart(const BackendOptions& options, const CameraModel& camera, const RowTiming& timing);
 
   // Returns true once a two-view pose is found with this frame (then reference(), T_cur_ref()).
   bool addFrame(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr, const cv::Mat& working);
   const std::vector<StartFrame>& frames() const { return frames_; }
   const StartFrame& reference() const { return frames_.front(); }
   const SE3d& T_cur_ref() const { return initializer_.T_cur_ref(); }
+  const Vec6& xi() const { return initializer_.xi(); }  // both frames' twist (rolling shutter), else 0
   const std::string& status() const { return initializer_.status(); }
   void clear() { frames_.clear(); }
 

@@ -99,7 +99,7 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   for (const auto& m : motion) motion_ptrs.push_back(m.get());
   tracking = std::make_unique<Tracking>(to, *camera, timing, motion_ptrs);
   window = std::make_unique<KeyframeWindow>(ws, *camera, timing, *solver);
-  start = std::make_unique<MonoStart>(bo, *camera);
+  start = std::make_unique<MonoStart>(bo, *camera, timing);
   if (io.enabled) {
     if (!sensors.has_imu)
       throw ConfigError("imu.enabled: the dataset " + sensors.dataset_dir +
@@ -360,6 +360,12 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   kf0->t_ns = ref.t_ns;
   kf0->exposure_ms = ref.exposure_ms;
   kf0->pyramid = ref.pyramid;
+  // Rolling shutter: both frames start with the two-view start's constant twist (mono_initializer.h);
+  // keyframe 1 gets it from the tracking history (the same velocity, ref and cur being its two entries).
+  if (rolling && bo.init_keyframe_twist) {
+    kf0->state.twist = start->xi();
+    kf0->twist_start = kf0->state.twist;
+  }
   Keyframe& k0 = window->insert(std::move(kf0));  // the first keyframe: the gauge
   if (FrameRecord* r = record->frame(ref.index)) {
     r->keyframe = true;
@@ -367,7 +373,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   }
   window->createCandidates(k0);
   CandidateFrame target;
-  target.pose = RsFrame{T_cur_ref, Vec6::Zero()};
+  target.pose = RsFrame{T_cur_ref, k0.state.twist};  // the two-view twist, or 0
   target.exposure_ms = frame.exposure_ms;
   window->traceCandidates(target, pyr->level(0));
   record->recordKeyframe(k0);

@@ -50,6 +50,8 @@ struct BackendOptions {
   double init_min_parallax_deg = 1.0; // median triangulation angle of the inlier corners
   double init_min_inlier_ratio = 0.6; // essential-matrix RANSAC inliers
   int init_corners = 400;             // corners tracked with pyramidal Lucas-Kanade
+  int init_rolling_shutter_iterations = 0;  // two-view rounds with the corners at their row times (mono_initializer.h)
+  bool init_keyframe_twist = false;   // rolling shutter: keyframe 0 starts with the two-view twist
   // Divergence detection (the run ends "failed" with the reason).
   int max_lost_frames = 3;            // consecutive frames the tracker loses
   double fail_max_rmse = 40.0;        // BA RMSE per pattern pixel, intensity units
