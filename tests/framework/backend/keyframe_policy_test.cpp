@@ -348,6 +348,8 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["init_min_parallax_deg"] = o.init_min_parallax_deg;
   got["init_min_inlier_ratio"] = o.init_min_inlier_ratio;
   got["init_corners"] = o.init_corners;
+  got["init_rolling_shutter_iterations"] = o.init_rolling_shutter_iterations;
+  got["init_keyframe_twist"] = o.init_keyframe_twist;
   got["max_lost_frames"] = o.max_lost_frames;
   got["fail_max_rmse"] = o.fail_max_rmse;
   got["fail_min_inlier_ratio"] = o.fail_min_inlier_ratio;
