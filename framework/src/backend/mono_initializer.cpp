@@ -419,7 +419,7 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
   std::ostringstream os;
   os << "essential matrix: " << fit.in.size() << "/" << m << " inliers, " << fit.front << " in front, median parallax "
      << r.parallax_deg << " deg";
-  if (rolling) os << ", rolling shutter corrected";
+  if (rolling && options.rolling_shutter_iterations > 0) os << ", rolling shutter corrected";
   r.status = os.str();
   std::vector<double> depth;
   for (int i : fit.in)

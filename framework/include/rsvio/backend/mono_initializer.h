@@ -45,7 +45,8 @@ namespace rsvio {
 class CameraModel;
 
 struct TwoViewOptions {
-  int rolling_shutter_iterations = 3;  // rounds of moving the bearings to the central poses
+  int rolling_shutter_iterations = 3;  // rounds of moving the bearings to the central poses (the odometry
+                                       // passes backend.init_rolling_shutter_iterations, default 0)
 };
 
 struct TwoViewResult {
