@@ -335,7 +335,15 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       for (int k = 0; k < NG0; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
       if constexpr (LD) G.col(NG0) = ol.Jl;
       MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G);
-      Hgg.noalias() = G.transpose().lazyProduct(MG);
+      if constexpr (KD == 14) {
+        // Upper triangle only (a <= c): all the rolling-shutter scatter below reads.
+        for (int a = 0; a < NG; ++a) {
+          const double g0 = G(0, a), g1 = G(1, a);
+          for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
+        }
+      } else {
+        Hgg.noalias() = G.transpose().lazyProduct(MG);
+      }
       Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
       bg.noalias() = -G.transpose() * ol.g.template head<2>();
       // Straight into the chunk's blocks: each entry of the host/target blocks receives the same one
@@ -348,22 +356,57 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       const Eigen::Index ld = cs.H.rows();
       auto at = [&](int x, int y) -> double& { return Hd[static_cast<Eigen::Index>(row[y]) * ld + row[x]]; };
       double hcol[N];  // column 2 KD of the local Hessian: d^2 E / d rho d x
-      for (int a = 0; a < ID; ++a) {
-        const int ga = gidx[a];
-        for (int c = 0; c < ID; ++c) at(ga, gidx[c]) += Hgg(a, c);
-        for (int c = 0; c < 4; ++c) {
-          at(ga, aidx[c]) += Hga(a, c);
-          at(aidx[c], ga) += Hga(a, c);
+      if constexpr (KD == 14) {
+        // Rolling shutter (25 geometric columns): only the upper triangles of Hgg and of cs.H are
+        // formed, and linearizePhotometric mirrors cs.H's to the lower triangle once: half the
+        // products and scattered additions of the full form (the largest cost of a rolling-shutter
+        // linearisation, profiled in docs/rolling_shutter.md, "Cost").
+        for (int a = 0; a < ID; ++a) {
+          const int ga = gidx[a];
+          const int ra = row[ga];
+          for (int c = a; c < ID; ++c) {
+            const int rc = row[gidx[c]];
+            Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hgg(a, c);
+          }
+          for (int c = 0; c < 4; ++c) {
+            const int rc = row[aidx[c]];
+            if (ra <= rc)
+              Hd[static_cast<Eigen::Index>(rc) * ld + ra] += Hga(a, c);
+            else
+              Hd[static_cast<Eigen::Index>(ra) * ld + rc] += Hga(a, c);
+          }
+          hcol[ga] = Hgg(a, ID);
+          cs.b[ra] += bg[a];
+          if constexpr (LD) cs.Hl[ra] += Hgg(a, NG0);
         }
-        hcol[ga] = Hgg(a, ID);
-        cs.b[row[ga]] += bg[a];
-        if constexpr (LD) cs.Hl[row[ga]] += Hgg(a, NG0);
-      }
-      for (int a = 0; a < 4; ++a) {
-        for (int c = 0; c < 4; ++c) at(aidx[a], aidx[c]) += ol.M(2 + a, 2 + c);
-        hcol[aidx[a]] = Hga(ID, a);
-        cs.b[row[aidx[a]]] += -ol.g[2 + a];
-        if constexpr (LD) cs.Hl[row[aidx[a]]] += Hga(NG0, a);
+        for (int a = 0; a < 4; ++a) {
+          const int ra = row[aidx[a]];
+          for (int c = 0; c < 4; ++c) {
+            const int rc = row[aidx[c]];
+            if (ra <= rc) Hd[static_cast<Eigen::Index>(rc) * ld + ra] += ol.M(2 + a, 2 + c);
+          }
+          hcol[aidx[a]] = Hga(ID, a);
+          cs.b[ra] += -ol.g[2 + a];
+          if constexpr (LD) cs.Hl[ra] += Hga(NG0, a);
+        }
+      } else {
+        for (int a = 0; a < ID; ++a) {
+          const int ga = gidx[a];
+          for (int c = 0; c < ID; ++c) at(ga, gidx[c]) += Hgg(a, c);
+          for (int c = 0; c < 4; ++c) {
+            at(ga, aidx[c]) += Hga(a, c);
+            at(aidx[c], ga) += Hga(a, c);
+          }
+          hcol[ga] = Hgg(a, ID);
+          cs.b[row[ga]] += bg[a];
+          if constexpr (LD) cs.Hl[row[ga]] += Hgg(a, NG0);
+        }
+        for (int a = 0; a < 4; ++a) {
+          for (int c = 0; c < 4; ++c) at(aidx[a], aidx[c]) += ol.M(2 + a, 2 + c);
+          hcol[aidx[a]] = Hga(ID, a);
+          cs.b[row[aidx[a]]] += -ol.g[2 + a];
+          if constexpr (LD) cs.Hl[row[aidx[a]]] += Hga(NG0, a);
+        }
       }
       Hpp += Hgg(ID, ID);
       bp += bg[ID];
@@ -420,6 +463,11 @@ void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundl
     L.num_in += c.num_in;
     L.num_oob += c.num_oob;
     L.num_outlier += c.num_outlier;
+  }
+  // Rolling shutter: the chunks wrote the upper triangle only (accumulateChunk<14>).
+  if (cfg.layout.rolling) {
+    for (Eigen::Index j = 0; j < m.nkd; ++j)
+      for (Eigen::Index i = j + 1; i < m.nkd; ++i) L.Hcc(i, j) = L.Hcc(j, i);
   }
 }
 

@@ -46,8 +46,10 @@ void dampAndMask(const BundleAdjuster::Impl& m, const Linearization& L, double l
   }
 }
 
-// H, b minus the chunks' Schur sums (photometric blocks and the line delay's row).
-void subtractSchur(const BundleAdjuster::Impl& m, Eigen::MatrixXd& H, Eigen::VectorXd& b) {
+// H, b minus the chunks' Schur sums (photometric blocks and the line delay's row). kd: the keyframe
+// block size the chunks were made with; for the rolling shutter's 14 they hold the diagonal and upper
+// keyframe blocks only (schurChunk<14>), and H's lower blocks are mirrored from its upper ones after.
+void subtractSchur(const BundleAdjuster::Impl& m, int kd, Eigen::MatrixXd& H, Eigen::VectorXd& b) {
   for (const ChunkSums& c : m.chunks) {
     H.topLeftCorner(m.nkd, m.nkd) -= c.H;
     b.head(m.nkd) -= c.b;
@@ -58,6 +60,9 @@ void subtractSchur(const BundleAdjuster::Impl& m, Eigen::MatrixXd& H, Eigen::Vec
       b[m.gl] -= c.bl;
     }
   }
+  if (kd == 14)
+    for (int j = 0; j < m.nkd / kd; ++j)
+      for (int i = j + 1; i < m.nkd / kd; ++i) H.block(i * kd, j * kd, kd, kd) = H.block(j * kd, i * kd, kd, kd).transpose();
 }
 
 template <int KD>
@@ -91,6 +96,8 @@ void schurChunk(BundleAdjuster::Impl& m, const Linearization& L, double lambda, 
       cs.b.template segment<KD>(ia * KD) += hm[a] * (bp * inv);
       for (int c = 0; c < nb; ++c) {
         const int ic = L.blk_ids[static_cast<size_t>(ab + c)];
+        // Rolling shutter: diagonal and upper blocks only, the lower ones mirrored in subtractSchur.
+        if (KD == 14 && ic < ia) continue;
         cs.H.template block<KD, KD>(ia * KD, ic * KD).noalias() += (hm[a] * inv) * hm[c].transpose();
       }
     }
@@ -137,7 +144,7 @@ bool solveSchur(BundleAdjuster::Impl& m, const Linearization& L, const BundleAdj
   } else {
     m.runner->run(kPointChunks, [&](int c) { schurChunk<8>(m, L, lambda, keep, c); });
   }
-  subtractSchur(m, H, b);
+  subtractSchur(m, cfg.layout.kfDim(), H, b);
   // Jacobi scaling: the inertial blocks bring information up to ~1e11 (a gyro bias over 0.1 s) beside
   // twists with ~1e-6; solving D H D y = D b, dx = D y (D = diag(H)^-1/2) is the same step in exact
   // arithmetic and keeps the dense factorisation accurate.
@@ -243,10 +250,7 @@ void removeScaleDirection(const BundleAdjuster::Impl& m, const Linearization& L,
   for (int i = 0; i < m.nc; ++i)
     if (m.fixed[static_cast<size_t>(i)] || !(L.Hcc(i, i) > kMinDiag)) keep[static_cast<size_t>(i)] = 0.0;
   Eigen::VectorXd n = Eigen::VectorXd::Zero(m.nc);
-  for (const auto& kf : *m.window) {
-    n.segment<3>(kf->index * kd + StateLayout::kPose) = kf->state.T_c_w.translation();
-    if (cfg.layout.rolling) n.segment<3>(kf->index * kd + StateLayout::kTwist) = kf->state.twist.head<3>();
-  }
+  for (const auto& kf : *m.window) scaleDirection(kf->state, cfg.layout, n.segment(kf->index * kd, kd));
   // With the inertial state the null direction scales T_Wm_Wf inversely: sigma = log s moves by -1.
   if (cfg.layout.inertial) n[cfg.layout.globalOffset(static_cast<int>(m.window->size())) + StateLayout::kGlobalScale] = -1.0;
   for (int i = 0; i < m.nc; ++i) n[i] *= keep[static_cast<size_t>(i)];
@@ -477,7 +481,7 @@ void BundleAdjuster::pointsTerm(const KeyframeList& window, const std::vector<Ac
   }
   Hf = m.cur.Hcc;
   bf = m.cur.bc;
-  ba::subtractSchur(m, Hf, bf);
+  ba::subtractSchur(m, config_.layout.kfDim(), Hf, bf);
   for (int i = 0; i < m.nc; ++i) {
     if (keep[static_cast<size_t>(i)] != 0.0) continue;
     Hf.row(i).setZero();

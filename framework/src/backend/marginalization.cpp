@@ -129,18 +129,11 @@ void MarginalizationPrior::addScaleFreeTerm(const std::vector<Keyframe*>& kfs, c
   for (Keyframe* kf : kfs) addKeyframe(kf);  // freezes x_lin of keyframes new to the prior
   // The global rows (the line delay: the scale does not change it) have no component along the scale.
   Eigen::VectorXd n = Eigen::VectorXd::Zero(H_t.rows());
-  for (size_t i = 0; i < kfs.size(); ++i) {
-    const Eigen::Index o = static_cast<Eigen::Index>(i) * d;
-    n.segment<3>(o + StateLayout::kPose) = kfs[i]->lin.T_c_w.translation();
-    if (layout_.rolling) n.segment<3>(o + StateLayout::kTwist) = kfs[i]->lin.twist.head<3>();
-  }
-  const double nn = n.squaredNorm();
-  if (!(nn > 0.0)) return addTerm(kfs, H_t, b_t, with_global);
-  const Eigen::VectorXd u = n / std::sqrt(nn);
-  const Eigen::VectorXd Hu = H_t * u;
-  const double uHu = u.dot(Hu);
-  const Eigen::MatrixXd H_p = H_t - u * Hu.transpose() - Hu * u.transpose() + uHu * (u * u.transpose());
-  const Eigen::VectorXd b_p = b_t - u * u.dot(b_t);
+  for (size_t i = 0; i < kfs.size(); ++i)
+    scaleDirection(kfs[i]->lin, layout_, n.segment(static_cast<Eigen::Index>(i) * d, d));
+  Eigen::MatrixXd H_p = H_t;
+  Eigen::VectorXd b_p = b_t;
+  if (!projectOffDirection(n, H_p, b_p)) return addTerm(kfs, H_t, b_t, with_global);
   addTerm(kfs, H_p, b_p, with_global);
 }
 

@@ -1,6 +1,8 @@
 // Keyframe state arithmetic in the block layout (contract in rsvio/backend/window.h).
 #include "rsvio/backend/window.h"
 
+#include <cmath>
+
 namespace rsvio {
 
 Eigen::VectorXd stateDelta(const KeyframeState& x, const KeyframeState& lin, const StateLayout& layout) {
@@ -16,6 +18,25 @@ Eigen::VectorXd stateDelta(const KeyframeState& x, const KeyframeState& lin, con
     d.segment<3>(o + StateLayout::kBiasAccel) = x.bias_accel - lin.bias_accel;
   }
   return d;
+}
+
+void scaleDirection(const KeyframeState& x, const StateLayout& layout, Eigen::Ref<Eigen::VectorXd> kf_block) {
+  kf_block.setZero();
+  kf_block.segment<3>(StateLayout::kPose) = x.T_c_w.translation();
+  if (layout.rolling) kf_block.segment<3>(StateLayout::kTwist) = x.twist.head<3>();
+}
+
+bool projectOffDirection(const Eigen::VectorXd& n, Eigen::MatrixXd& H, Eigen::VectorXd& b) {
+  const double nn = n.squaredNorm();
+  if (!(nn > 0.0)) return false;
+  const Eigen::VectorXd u = n / std::sqrt(nn);
+  const Eigen::VectorXd Hu = H * u;
+  const double uHu = u.dot(Hu);
+  // Written as H - u Hu^T - Hu u^T + uHu u u^T, coefficient by coefficient in this order.
+  const Eigen::MatrixXd H_p = H - u * Hu.transpose() - Hu * u.transpose() + uHu * (u * u.transpose());
+  H = H_p;
+  b = b - u * u.dot(b);
+  return true;
 }
 
 void applyStep(KeyframeState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout) {

@@ -27,10 +27,55 @@ Mat36 dLeftAction(const Vec3& p) {
   return J;
 }
 
-// exp(d) and the left Jacobian Jl(d) with the global-shutter case (d = 0: zero twist or row time 0)
-// taken without trigonometry; the results are the same.
-SE3d expOrIdentity(const Vec6& d) { return d.isZero(0.0) ? SE3d() : SE3d::exp(d); }
-Mat6 leftJacobianOrIdentity(const Vec6& d) { return d.isZero(0.0) ? Mat6::Identity().eval() : SE3d::leftJacobian(d); }
+// exp(xi t) of one twist at many row times t (eq. 6 along a frame's rows), as a rotation matrix and a
+// translation. With W = [omega]x, phi = |omega| t and SO(3)'s coefficients of lie_common.h
+// (a = sin(phi)/phi, b = (1 - cos phi)/phi^2, c = (phi - sin phi)/phi^3, series below 1 rad):
+//   R(t) = I + t a W + t^2 b W^2,   p(t) = Jl(omega t) v t = t v + t^2 b (W v) + t^3 c (W W v),
+// the same as SE3d::exp(xi * t) (rsvio/lie/se3.h), with W, W^2, W v and W W v formed once per twist.
+struct TwistExp {
+  Mat3 W, W2;
+  Vec3 v, Wv, WWv;
+  double theta = 0.0;
+  bool zero = true;
+  explicit TwistExp(const Vec6& xi) {
+    v = xi.head<3>();
+    const Vec3 w = xi.tail<3>();
+    zero = xi.isZero(0.0);
+    theta = w.norm();
+    W = SO3d::hat(w);
+    W2 = w * w.transpose() - (theta * theta) * Mat3::Identity();
+    Wv = w.cross(v);
+    WWv = w.cross(Wv);
+  }
+  // The global-shutter case (zero twist or t = 0) is exactly the identity.
+  void at(double t, Mat3& R, Vec3& p) const {
+    if (zero || t == 0.0) {
+      R.setIdentity();
+      p.setZero();
+      return;
+    }
+    const double phi = theta * t < 0.0 ? -theta * t : theta * t;
+    const double a = t * lie::sinOverTheta(phi), b = t * t * lie::oneMinusCosOverTheta2(phi);
+    const double c = t * t * t * lie::thetaMinusSinOverTheta3(phi);
+    R = Mat3::Identity() + a * W + b * W2;
+    p = t * v + b * Wv + c * WWv;
+  }
+};
+
+// [I, -[p]x] Jl(d) for SE3's left Jacobian Jl(d) = [J, Q; 0, J]: [J, Q - [p]x J], without the
+// 3x6 by 6x6 product. d = 0 (a global shutter) gives [I, -[p]x] exactly.
+Mat36 dLeftActionTimesJl(const Vec3& p, const Vec6& d) {
+  Mat36 M;
+  if (d.isZero(0.0)) {
+    M.leftCols<3>().setIdentity();
+    M.rightCols<3>() = -SO3d::hat(p);
+    return M;
+  }
+  const Mat6 Jl = SE3d::leftJacobian(d);
+  M.leftCols<3>() = Jl.topLeftCorner<3, 3>();
+  M.rightCols<3>() = Jl.topRightCorner<3, 3>() - SO3d::hat(p) * Jl.bottomRightCorner<3, 3>();
+  return M;
+}
 
 // Left-multiplies a 2xK Jacobian by M = (I - a e_v^T)^-1 = [1, a_x / (1 - a_y); 0, 1 / (1 - a_y)].
 template <class Derived>
@@ -50,8 +95,9 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
   const Vec3 xi_v = target.xi.head<3>();
   const Vec3 xi_w = target.xi.tail<3>();
 
+  const TwistExp ex(target.xi);
   std::vector<Vec3> P0(n), P(n);
-  std::vector<SE3d> E(n);
+  std::vector<Mat3> E(n);  // rotation of exp(xi t) at the current row
   std::vector<Jac23> Jc(n);
   std::vector<Vec2> a(n, Vec2::Zero());
   std::vector<double> v(n, timing.y0);  // start at t = 0: the first evaluation is the global-shutter pixel
@@ -71,8 +117,9 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     Pa.resize(3, static_cast<Eigen::Index>(active.size()));
     for (size_t k = 0; k < active.size(); ++k) {
       const size_t i = active[k];
-      E[i] = expOrIdentity(target.xi * timing.rowTime(v[i]));  // eq. 6 at the row's time (eq. 7)
-      P[i] = E[i] * P0[i];
+      Vec3 p;
+      ex.at(timing.rowTime(v[i]), E[i], p);  // eq. 6 at the row's time (eq. 7)
+      P[i] = E[i] * P0[i] + p;
       Pa.col(static_cast<Eigen::Index>(k)) = P[i];
     }
     camera.project(Pa, uva, va, need_J ? &Ja : nullptr);  // one batch call per iteration
@@ -107,11 +154,11 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     RsProjection& r = *out[i];
     if (!r.valid) continue;
     const double t = r.t_s;
-    const Eigen::Matrix<double, 2, 3> JR = Jc[i] * E[i].rotationMatrix();
+    const Eigen::Matrix<double, 2, 3> JR = Jc[i] * E[i];
     // Partial derivatives at a fixed row, then M for the row's own dependence on the state.
     r.d_uv_d_T0 = JR * dLeftAction(P0[i]);
     if (t != 0.0)
-      r.d_uv_d_xi = Jc[i] * dLeftAction(P[i]) * leftJacobianOrIdentity(target.xi * t) * t;
+      r.d_uv_d_xi = Jc[i] * dLeftActionTimesJl(P[i], target.xi * t) * t;
     else
       r.d_uv_d_xi.setZero();
     r.d_uv_d_X = JR * target.T_c_w0.rotationMatrix();
@@ -151,7 +198,8 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
   // X_w = T_h_w0^-1 exp(-xi_h t_h) (b / rho); points with rho <= 0 are left out (invalid).
   std::vector<Eigen::Index> idx;
   std::vector<Vec3> Z(static_cast<size_t>(n));
-  std::vector<SE3d> Eh_inv(static_cast<size_t>(n));
+  const TwistExp ex_h(host.xi);
+  std::vector<Mat3> Eh_inv(static_cast<size_t>(n));  // rotation of exp(-xi_h t_h)
   Eigen::Matrix3Xd X(3, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const double rho = idepth[i];
@@ -164,8 +212,9 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
     o.d_uv_d_Th0.setZero();
     o.d_uv_d_xi_h.setZero();
     o.d_uv_d_idepth.setZero();
-    Eh_inv[s] = expOrIdentity(-host.xi * timing.rowTime(v_h[i]));
-    Z[s] = Eh_inv[s] * Vec3(bearing_h.col(i) / rho);
+    Vec3 p;
+    ex_h.at(-timing.rowTime(v_h[i]), Eh_inv[s], p);  // exp(xi_h (-t_h))
+    Z[s] = Eh_inv[s] * Vec3(bearing_h.col(i) / rho) + p;
     X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * Z[s];
     idx.push_back(i);
   }
@@ -186,10 +235,10 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
     r.d_uv_d_Th0 = -d_uv_d_Z * dLeftAction(Z[s]);
     // Host twist: Z = exp(-xi_h t_h) Y,  d Z / d xi_h = [I, -[Z]x] Jl(-xi_h t_h) (-t_h).
     if (t_h != 0.0)
-      r.d_uv_d_xi_h = d_uv_d_Z * dLeftAction(Z[s]) * leftJacobianOrIdentity(-host.xi * t_h) * (-t_h);
+      r.d_uv_d_xi_h = d_uv_d_Z * dLeftActionTimesJl(Z[s], -host.xi * t_h) * (-t_h);
     else
       r.d_uv_d_xi_h.setZero();
-    r.d_uv_d_idepth = d_uv_d_Z * (Eh_inv[s].rotationMatrix() * Vec3(-bearing_h.col(i) / (rho * rho)));
+    r.d_uv_d_idepth = d_uv_d_Z * (Eh_inv[s] * Vec3(-bearing_h.col(i) / (rho * rho)));
     // Host row time: d Z / d t_h = -(xi_v + xi_w x Z).
     r.d_uv_d_line_delay += d_uv_d_Z * Vec3(-(xh_v + xh_w.cross(Z[s]))) * timing.dRowTimeDLineDelay(v_h[i]);
   }

@@ -180,6 +180,46 @@ TEST(SmoothMotionTerm, OneKeyframesTermIsItsShareOfTheWindowSystem) {
   EXPECT_EQ(term.linearize(c.window, gs, H, b), 0.0);
 }
 
+// Scaling W_f by s scales every residual's translation by s (log(T_b T_a^-1) and the twist velocity
+// both scale), so E(s) = s^2 E_t + E_r and dE/ds = 2 E_t along the monocular scale direction n
+// (window.h scaleDirection). The normal equations must say the same, -2 b.n = 2 E_t: an identity that
+// checks the pose and twist Jacobians along the translations as a whole (a pose Jacobian off by 0.8x
+// fails it). It is also why the term is handed to the prior scale-free (smooth_motion_term.h).
+TEST(SmoothMotionTerm, NormalEquationsAlongTheScaleAreTheEnergysScaleDerivative) {
+  Chain c;
+  const SmoothMotionTerm term(options());
+  const int kd = c.layout.kfDim();
+  const Eigen::Index n = 3 * kd;
+  Eigen::VectorXd dir(n);
+  for (const auto& kf : c.window) scaleDirection(kf->state, c.layout, dir.segment(kf->index * kd, kd));
+  double e_t = 0.0;
+  for (const auto& kf : c.window) {
+    SmoothMotionTerm::Eval e;
+    if (!term.evaluate(*kf, &e)) continue;
+    e_t += e.r.head<3>().dot(e.W.topLeftCorner<3, 3>() * e.r.head<3>());
+  }
+  ASSERT_GT(e_t, 1e-3);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  term.linearize(c.window, c.layout, H, b);
+  // Energy along the scale, from scaled states.
+  auto scaledEnergy = [&](double s) {
+    Chain d;
+    for (auto& kf : d.window) {
+      kf->state.T_c_w.translation() *= s;
+      kf->state.twist.head<3>() *= s;
+    }
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, n);
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+    return term.linearize(d.window, d.layout, h, v);
+  };
+  const double eps = 1e-5;
+  EXPECT_NEAR((scaledEnergy(1 + eps) - scaledEnergy(1 - eps)) / (2 * eps), 2.0 * e_t, 1e-6 * e_t);
+  EXPECT_NEAR(-b.dot(dir), e_t, 1e-9 * e_t);
+  // Gauss-Newton curvature along the scale: J n = (r_t, 0) per term, so n^T H n = sum r_t^T W_t r_t = E_t.
+  EXPECT_NEAR(dir.dot(H * dir), e_t, 1e-9 * e_t);
+}
+
 // The record the old disabled test kept: with only a loose fixed prior the twist wanders in a
 // 4-keyframe window. With the smooth-motion term (no fixed mean at all, twists started 0.3 m/s and
 // 0.17 rad/s off) the twists converge to the poses' own motion and the poses stay right.

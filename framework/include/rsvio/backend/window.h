@@ -187,6 +187,16 @@ void applyStep(KeyframeState& x, const Eigen::Ref<const Eigen::VectorXd>& step, 
 Eigen::VectorXd globalDelta(const GlobalState& x, const GlobalState& lin, const StateLayout& layout);
 void applyGlobalStep(GlobalState& x, const Eigen::Ref<const Eigen::VectorXd>& step, const StateLayout& layout);
 
+// The monocular scale direction over one keyframe's photometric block (kfDim() rows, written into
+// kf_block): d/ds at s = 1 of scaling W_f about its origin by s, in the left-perturbation coordinates
+// above: the pose translation t and the twist velocity v (rolling), zero elsewhere. (The points'
+// inverse depths move by -rho and T_Wm_Wf's log-scale by -1; those rows are not in this block.)
+void scaleDirection(const KeyframeState& x, const StateLayout& layout, Eigen::Ref<Eigen::VectorXd> kf_block);
+
+// Projects the unit direction u = n / |n| off a quadratic term: H <- P H P, b <- P b, P = I - u u^T, so
+// the term has neither gradient nor curvature along n. Returns false (nothing changed) when n is zero.
+bool projectOffDirection(const Eigen::VectorXd& n, Eigen::MatrixXd& H, Eigen::VectorXd& b);
+
 // A keyframe's full state step gathered from the window system (photometric and inertial blocks).
 Eigen::VectorXd gatherState(const Eigen::VectorXd& x_win, int k, int n, const StateLayout& layout);
 
