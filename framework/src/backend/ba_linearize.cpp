@@ -170,7 +170,7 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   const AffineTransfer tr = affineTransfer(pw.host->state.affine, pw.target->state.affine, exposure_ratio);
   const float alpha = static_cast<float>(tr.alpha), beta = static_cast<float>(tr.beta);
   const Eigen::Matrix3d R_w_h0 = pw.host->state.T_c_w.so3().inverse().matrix();
-  const Vec3 omega_h = host.xi.tail<3>();
+  const TwistExp host_exp(host.xi);  // the host's row rotations exp(-omega_h t_h)
   const float e_out = kernel.outlier_energy;
 
   // Visit the observations in the order of their target rows (counting sort, stable): the pattern
@@ -200,7 +200,7 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
     if (!pr.valid) continue;
     // Local warp W = d p' / d p (host pixel -> target pixel at fixed inverse depth).
     Eigen::Matrix3d R_w_hp = R_w_h0;
-    if (rolling) R_w_hp = R_w_h0 * SO3d::exp(-omega_h * timing.rowTime(p.v)).matrix();
+    if (rolling) R_w_hp = R_w_h0 * host_exp.rotation(-timing.rowTime(p.v));
     const Eigen::Matrix2d Wm = pr.d_uv_d_X * R_w_hp * p.d_bearing_d_uv * (1.0 / p.idepth);
     const float warp[4] = {static_cast<float>(Wm(0, 0)), static_cast<float>(Wm(0, 1)), static_cast<float>(Wm(1, 0)),
                            static_cast<float>(Wm(1, 1))};

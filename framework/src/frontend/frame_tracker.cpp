@@ -63,6 +63,7 @@ void FrameTracker::setReference(const TrackingReference& reference) {
     auto L = std::make_unique<LevelPoints>();
     const ResidualOptions& ro = options_.residual;
     std::vector<Vec3> X;
+    const TwistExp ref_exp(ref_.twist);
     for (size_t i = 0; i < uv0.size(); ++i) {
       if (!valid[i]) continue;
       PatternHost host;
@@ -70,7 +71,7 @@ void FrameTracker::setReference(const TrackingReference& reference) {
       // Fixed in the world at the host row's capture time (eq. 6 at t(v_h), eq. 7).
       const double t_h = timing_.rowTime(uv0[i].y());
       const Vec3 Z_c = bearing.col(static_cast<Eigen::Index>(i)) / idepth[i];
-      const Vec3 Z = t_h == 0.0 ? Z_c : Vec3(SE3d::exp(-ref_.twist * t_h) * Z_c);
+      const Vec3 Z = t_h == 0.0 ? Z_c : ref_exp.apply(-t_h, Z_c);
       X.push_back(T_w_h0 * Z);
       L->host.push_back(host);
       L->host_uv0.push_back(uv0[i]);
@@ -117,6 +118,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
     return;
   }
   const Vec3 xi_v = target.xi.head<3>(), xi_w = target.xi.tail<3>();
+  const TwistExp ex(target.xi);
   if (B.row.size() != static_cast<size_t>(n)) B.row.assign(static_cast<size_t>(n), timing_.y0);
   B.uv.resize(2, n);
   B.valid.assign(static_cast<size_t>(n), 0);
@@ -128,7 +130,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
     for (Eigen::Index k = 0; k < m; ++k) {
       const int i = B.active[static_cast<size_t>(k)];
       const double ti = timing_.rowTime(B.row[static_cast<size_t>(i)]);
-      B.P.col(k) = SE3d::exp(target.xi * ti) * Vec3(B.P0.col(i));  // eq. 6 at the row's time (eq. 7)
+      B.P.col(k) = ex.apply(ti, Vec3(B.P0.col(i)));  // eq. 6 at the row's time (eq. 7)
     }
     camera_.project(B.P, B.uv_a, B.valid_a, &B.J);
     B.still.clear();
@@ -156,7 +158,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       B.uv.col(i) = B.uv_a.col(k) + a * step;
       B.valid[si] = 1;
       if (linearize) {
-        Mat26 D = J * SO3d::exp(xi_w * ti).matrix() * dLeftAction(B.P0.col(i));
+        Mat26 D = J * ex.rotation(ti) * dLeftAction(B.P0.col(i));
         const double inv = 1.0 / denom;
         D.row(0) += (a.x() * inv) * D.row(1);
         D.row(1) *= inv;

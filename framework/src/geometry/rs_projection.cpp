@@ -27,41 +27,6 @@ Mat36 dLeftAction(const Vec3& p) {
   return J;
 }
 
-// exp(xi t) of one twist at many row times t (eq. 6 along a frame's rows), as a rotation matrix and a
-// translation. With W = [omega]x, phi = |omega| t and SO(3)'s coefficients of lie_common.h
-// (a = sin(phi)/phi, b = (1 - cos phi)/phi^2, c = (phi - sin phi)/phi^3, series below 1 rad):
-//   R(t) = I + t a W + t^2 b W^2,   p(t) = Jl(omega t) v t = t v + t^2 b (W v) + t^3 c (W W v),
-// the same as SE3d::exp(xi * t) (rsvio/lie/se3.h), with W, W^2, W v and W W v formed once per twist.
-struct TwistExp {
-  Mat3 W, W2;
-  Vec3 v, Wv, WWv;
-  double theta = 0.0;
-  bool zero = true;
-  explicit TwistExp(const Vec6& xi) {
-    v = xi.head<3>();
-    const Vec3 w = xi.tail<3>();
-    zero = xi.isZero(0.0);
-    theta = w.norm();
-    W = SO3d::hat(w);
-    W2 = w * w.transpose() - (theta * theta) * Mat3::Identity();
-    Wv = w.cross(v);
-    WWv = w.cross(Wv);
-  }
-  // The global-shutter case (zero twist or t = 0) is exactly the identity.
-  void at(double t, Mat3& R, Vec3& p) const {
-    if (zero || t == 0.0) {
-      R.setIdentity();
-      p.setZero();
-      return;
-    }
-    const double phi = theta * t < 0.0 ? -theta * t : theta * t;
-    const double a = t * lie::sinOverTheta(phi), b = t * t * lie::oneMinusCosOverTheta2(phi);
-    const double c = t * t * t * lie::thetaMinusSinOverTheta3(phi);
-    R = Mat3::Identity() + a * W + b * W2;
-    p = t * v + b * Wv + c * WWv;
-  }
-};
-
 // [I, -[p]x] Jl(d) for SE3's left Jacobian Jl(d) = [J, Q; 0, J]: [J, Q - [p]x J], without the
 // 3x6 by 6x6 product. d = 0 (a global shutter) gives [I, -[p]x] exactly.
 Mat36 dLeftActionTimesJl(const Vec3& p, const Vec6& d) {

@@ -38,6 +38,55 @@ class ShutterModel;
 
 using Mat26 = Eigen::Matrix<double, 2, 6>;
 
+// exp(xi t) of one twist at many row times t (eq. 6 along a frame's rows), as a rotation matrix and a
+// translation. With W = [omega]x, phi = |omega| t and SO(3)'s coefficients of lie_common.h
+// (a = sin(phi)/phi, b = (1 - cos phi)/phi^2, c = (phi - sin phi)/phi^3, series below 1 rad):
+//   R(t) = I + t a W + t^2 b W^2,   p(t) = Jl(omega t) v t = t v + t^2 b (W v) + t^3 c (W W v),
+// the same as SE3d::exp(xi * t) (rsvio/lie/se3.h), with W, W^2, W v and W W v formed once per twist.
+struct TwistExp {
+  TwistExp() = default;
+  Mat3 W = Mat3::Zero(), W2 = Mat3::Zero();
+  Vec3 v = Vec3::Zero(), Wv = Vec3::Zero(), WWv = Vec3::Zero();
+  double theta = 0.0;
+  bool zero = true;
+  explicit TwistExp(const Vec6& xi) {
+    v = xi.head<3>();
+    const Vec3 w = xi.tail<3>();
+    zero = xi.isZero(0.0);
+    theta = w.norm();
+    W = SO3d::hat(w);
+    W2 = w * w.transpose() - (theta * theta) * Mat3::Identity();
+    Wv = w.cross(v);
+    WWv = w.cross(Wv);
+  }
+  // The global-shutter case (zero twist or t = 0) is exactly the identity.
+  void at(double t, Mat3& R, Vec3& p) const {
+    if (zero || t == 0.0) {
+      R.setIdentity();
+      p.setZero();
+      return;
+    }
+    const double phi = theta * t < 0.0 ? -theta * t : theta * t;
+    const double a = t * lie::sinOverTheta(phi), b = t * t * lie::oneMinusCosOverTheta2(phi);
+    const double c = t * t * t * lie::thetaMinusSinOverTheta3(phi);
+    R = Mat3::Identity() + a * W + b * W2;
+    p = t * v + b * Wv + c * WWv;
+  }
+  // The rotation alone.
+  Mat3 rotation(double t) const {
+    if (zero || t == 0.0) return Mat3::Identity();
+    const double phi = theta * t < 0.0 ? -theta * t : theta * t;
+    return Mat3::Identity() + (t * lie::sinOverTheta(phi)) * W + (t * t * lie::oneMinusCosOverTheta2(phi)) * W2;
+  }
+  // exp(xi t) applied to a point.
+  Vec3 apply(double t, const Vec3& X) const {
+    Mat3 R;
+    Vec3 p;
+    at(t, R, p);
+    return R * X + p;
+  }
+};
+
 // When each raw row is read: t(v) = direction * line_delay_s * (v - y0).
 struct RowTiming {
   double y0 = 0.0;            // raw row of the image timestamp, (h - 1) / 2
