@@ -273,7 +273,9 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
 // Accumulates the points of one chunk: their Schur data and the camera blocks. LD: the line delay is
 // estimated, one more geometric column (after the inverse depth) whose row goes to ChunkSums::Hl, Hll,
 // bl and, for the inverse depth, to Linearization::hpl.
-template <int KD, bool LD>
+// PO (points only, BundleAdjuster::optimizeDepths): only each point's H_pp and b_p and the counts and
+// energies, no camera blocks; the same numbers as the full accumulation (bit-identical).
+template <int KD, bool LD, bool PO = false>
 void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   // Per observation, Hl = Jl^T M Jl over the N = 2 KD + 1 coordinates (host block, target block,
   // inverse depth) is formed compactly: only NG geometric columns (poses, twists when rolling, inverse
@@ -285,9 +287,11 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   constexpr int NG = NG0 + (LD ? 1 : 0);  // and the line delay (index NG0)
   using GM = Eigen::Matrix<double, 2, NG>;
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
-  cs.H.setZero();
-  cs.b.setZero();
-  cs.Hl.setZero();
+  if constexpr (!PO) {
+    cs.H.setZero();
+    cs.b.setZero();
+    cs.Hl.setZero();
+  }
   cs.Hll = cs.bl = 0.0;
   cs.energy = cs.energy_in = 0.0;
   cs.num_in = cs.num_oob = cs.num_outlier = 0;
@@ -335,6 +339,13 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       for (int k = 0; k < NG0; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
       if constexpr (LD) G.col(NG0) = ol.Jl;
       MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G);
+      if constexpr (PO && KD == 14) {
+        // The inverse depth's entries alone, as the triangle below forms them.
+        Hpp += G(0, ID) * MG(0, ID) + G(1, ID) * MG(1, ID);
+        bg.noalias() = -G.transpose() * ol.g.template head<2>();
+        bp += bg[ID];
+        continue;
+      }
       if constexpr (KD == 14) {
         // Upper triangle only (a <= c): all the rolling-shutter scatter below reads.
         for (int a = 0; a < NG; ++a) {
@@ -346,6 +357,11 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       }
       Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
       bg.noalias() = -G.transpose() * ol.g.template head<2>();
+      if constexpr (PO) {  // global shutter
+        Hpp += Hgg(ID, ID);
+        bp += bg[ID];
+        continue;
+      }
       // Straight into the chunk's blocks: each entry of the host/target blocks receives the same one
       // addition per observation as through an N x N staging matrix (bit-identical), without writing
       // and re-reading that matrix. Local index x < KD is the host block, KD <= x < 2 KD the target's,
@@ -431,13 +447,29 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
 }  // namespace
 
 void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                          const CameraModel& camera, const RowTiming& timing) {
+                          const CameraModel& camera, const RowTiming& timing, bool points_only) {
   const ResidualKernel kernel(cfg.residual);
   // The line delay being estimated is the globals' (the given timing's otherwise).
   m.timing = timing;
   if (m.gl >= 0 && m.globals) m.timing.line_delay_s = m.globals->state.line_delay_s;
   m.runner->run(static_cast<int>(m.pairs.size()),
                 [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, m.timing, kernel); });
+  if (points_only) {
+    if (cfg.layout.rolling)
+      m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, false, true>(m, L, c); });
+    else
+      m.runner->run(kPointChunks, [&](int c) { accumulateChunk<8, false, true>(m, L, c); });
+    L.energy_photo = L.energy_photo_in = 0.0;
+    L.num_in = L.num_oob = L.num_outlier = 0;
+    for (const ChunkSums& c : m.chunks) {
+      L.energy_photo += c.energy;
+      L.energy_photo_in += c.energy_in;
+      L.num_in += c.num_in;
+      L.num_oob += c.num_oob;
+      L.num_outlier += c.num_outlier;
+    }
+    return;
+  }
   if (m.gl >= 0) {
     m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, true>(m, L, c); });
   } else if (cfg.layout.rolling) {

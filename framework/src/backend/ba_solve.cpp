@@ -13,8 +13,10 @@ namespace rsvio {
 namespace ba {
 void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleAdjustmentConfig& cfg,
                     const std::vector<ActivePoint*>* only);
+// points_only: each point's H_pp, b_p, the observations and the energies, no camera blocks (L.Hcc,
+// L.bc, L.hpc are left as they were: optimizeDepths reads none of them).
 void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                          const CameraModel& camera, const RowTiming& timing);
+                          const CameraModel& camera, const RowTiming& timing, bool points_only = false);
 void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
                     const std::vector<const WindowTerm*>& terms);
 double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
@@ -430,7 +432,7 @@ void BundleAdjuster::optimizeDepths(KeyframeList& window, const std::vector<Acti
     for (int r = m.point_obs_begin[i]; r < m.point_obs_begin[i + 1]; ++r) e += L.obs[static_cast<size_t>(r)].energy;
     return e;
   };
-  ba::linearizePhotometric(m, m.cur, config_, camera_, timing_);
+  ba::linearizePhotometric(m, m.cur, config_, camera_, timing_, true);
   std::vector<double> step(np, 0.0), energy(np), backup(np);
   for (size_t i = 0; i < np; ++i) {
     energy[i] = pointEnergy(m.cur, i);
@@ -441,7 +443,7 @@ void BundleAdjuster::optimizeDepths(KeyframeList& window, const std::vector<Acti
       backup[i] = m.points[i]->idepth;
       m.points[i]->idepth = std::max(backup[i] + step[i], 1e-6);
     }
-    ba::linearizePhotometric(m, m.trial, config_, camera_, timing_);
+    ba::linearizePhotometric(m, m.trial, config_, camera_, timing_, true);
     for (size_t i = 0; i < np; ++i) {
       const double e = pointEnergy(m.trial, i);
       if (e < energy[i]) {

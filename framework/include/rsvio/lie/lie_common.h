@@ -7,7 +7,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
 #include <cmath>
 
 namespace rsvio {
@@ -54,32 +53,17 @@ Eigen::Matrix<S, 3, 3> skew(const Eigen::Matrix<S, 3, 1>& w) {
 
 namespace detail {
 
-// Coefficients (-1)^k w_k / (2k + m)! for k = 0..9, computed at compile time (long double, then
-// rounded once), with w_k = 1 or, for se3QCoeff3, k + 1.
-template <class S, int M, bool kPlusOne = false>
-struct FactorialSeriesTable {
-  static constexpr std::array<S, 10> make() {
-    std::array<S, 10> a{};
-    long double f = 1.0L;
-    for (int i = 2; i <= M; ++i) f *= static_cast<long double>(i);
-    for (int k = 0; k < 10; ++k) {
-      const long double w = kPlusOne ? static_cast<long double>(k + 1) : 1.0L;
-      a[static_cast<size_t>(k)] = static_cast<S>((k % 2 ? -w : w) / f);
-      f *= static_cast<long double>(2 * k + M + 1) * static_cast<long double>(2 * k + M + 2);
-    }
-    return a;
+// Sum_{k=0}^{n-1} (-1)^k theta^{2k} / (2k + m)!  (m! times the series of a coefficient whose k-th
+// Taylor term is (-1)^k theta^{2k} / (2k + m)!).
+template <class S>
+S alternatingFactorialSeries(S theta2, int m, int n = 10) {
+  S term(1);
+  for (int i = 2; i <= m; ++i) term /= S(i);
+  S sum(0);
+  for (int k = 0; k < n; ++k) {
+    sum += term;
+    term *= -theta2 / (S(2 * k + m + 1) * S(2 * k + m + 2));
   }
-  static constexpr std::array<S, 10> c = make();
-};
-
-// Sum_{k=0}^{9} (-1)^k w_k theta^{2k} / (2k + m)! (the Taylor series of a coefficient whose k-th term
-// is that), by Horner's rule in theta^2: multiplications only (the series branches below are on the
-// rolling-shutter row solve's hot path, with angles of ~0.01 rad).
-template <int M, bool kPlusOne = false, class S>
-S alternatingFactorialSeries(S theta2) {
-  const std::array<S, 10>& c = FactorialSeriesTable<S, M, kPlusOne>::c;
-  S sum = c[9];
-  for (int k = 8; k >= 0; --k) sum = sum * theta2 + c[static_cast<size_t>(k)];
   return sum;
 }
 
@@ -89,7 +73,7 @@ S alternatingFactorialSeries(S theta2) {
 template <class S>
 S sinOverTheta(S theta) {
   using std::sin;
-  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries<1>(theta * theta);
+  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries(theta * theta, 1);
   return sin(theta) / theta;
 }
 
@@ -97,7 +81,7 @@ S sinOverTheta(S theta) {
 template <class S>
 S oneMinusCosOverTheta2(S theta) {
   using std::cos;
-  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries<2>(theta * theta);
+  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries(theta * theta, 2);
   return (S(1) - cos(theta)) / (theta * theta);
 }
 
@@ -105,7 +89,7 @@ S oneMinusCosOverTheta2(S theta) {
 template <class S>
 S thetaMinusSinOverTheta3(S theta) {
   using std::sin;
-  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries<3>(theta * theta);
+  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries(theta * theta, 3);
   return (theta - sin(theta)) / (theta * theta * theta);
 }
 
@@ -113,7 +97,7 @@ S thetaMinusSinOverTheta3(S theta) {
 template <class S>
 S se3QCoeff2(S theta) {
   using std::cos;
-  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries<4>(theta * theta);
+  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries(theta * theta, 4);
   const S t2 = theta * theta;
   return (t2 + S(2) * cos(theta) - S(2)) / (S(2) * t2 * t2);
 }
@@ -125,7 +109,15 @@ S se3QCoeff3(S theta) {
   using std::cos;
   using std::sin;
   const S t2 = theta * theta;
-  if (theta < Constants<S>::seriesAngle()) return detail::alternatingFactorialSeries<5, true>(t2);
+  if (theta < Constants<S>::seriesAngle()) {
+    S term = S(1) / S(120);
+    S sum(0);
+    for (int k = 0; k < 10; ++k) {
+      sum += S(k + 1) * term;
+      term *= -t2 / (S(2 * k + 6) * S(2 * k + 7));
+    }
+    return sum;
+  }
   return (S(2) * theta - S(3) * sin(theta) + theta * cos(theta)) / (S(2) * t2 * t2 * theta);
 }
 

@@ -42,7 +42,7 @@ class SE3 {
   // exp(xi) = (exp(omega), Jl(omega) upsilon).
   static SE3 exp(const Tangent& xi) {
     const Vector3 omega = xi.template tail<3>();
-    return SE3(SO3Type::exp(omega), SO3Type::leftJacobianTimes(omega, xi.template head<3>()));
+    return SE3(SO3Type::exp(omega), SO3Type::leftJacobian(omega) * xi.template head<3>());
   }
   // (Jl(omega)^-1 t; omega), omega = log(R) with angle in [0, pi].
   Tangent log() const {
@@ -190,20 +190,11 @@ class SE3 {
     using std::sqrt;
     const Vector3 omega = xi.template tail<3>();
     const Scalar t = sqrt(omega.squaredNorm());
-    const Vector3 upsilon = xi.template head<3>();
-    const Matrix3 U = SO3Type::hat(upsilon);
+    const Matrix3 U = SO3Type::hat(xi.template head<3>());
     const Matrix3 W = SO3Type::hat(omega);
-    // The products of the contract in closed form ([a]x [b]x = b a^T - (a.b) I, W omega = 0), with
-    // s = omega . upsilon, x = omega x upsilon:
-    //   WU + UW + WUW = upsilon omega^T + omega upsilon^T - 2 s I - s W,
-    //   WWU + UWW - 3 WUW = x omega^T - omega x^T + s W,   WUWW + WWUW = -2 s (omega omega^T - t^2 I).
-    const Scalar s = omega.dot(upsilon);
-    const Vector3 x = omega.cross(upsilon);
-    const Matrix3 I = Matrix3::Identity();
-    const Matrix3 A = upsilon * omega.transpose() + omega * upsilon.transpose() - Scalar(2) * s * I - s * W;
-    const Matrix3 B = x * omega.transpose() - omega * x.transpose() + s * W;
-    const Matrix3 C = Scalar(-2) * s * (omega * omega.transpose() - (t * t) * I);
-    return U / Scalar(2) + lie::thetaMinusSinOverTheta3(t) * A + lie::se3QCoeff2(t) * B + lie::se3QCoeff3(t) * C;
+    const Matrix3 WU = W * U, UW = U * W, WUW = WU * W;
+    return U / Scalar(2) + lie::thetaMinusSinOverTheta3(t) * (WU + UW + WUW) +
+           lie::se3QCoeff2(t) * (W * WU + UW * W - Scalar(3) * WUW) + lie::se3QCoeff3(t) * (WUW * W + W * WUW);
   }
 
   SO3Type so3_;

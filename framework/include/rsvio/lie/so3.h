@@ -161,20 +161,9 @@ class SO3 {
   //   Jl = I + (1 - cos t)/t^2 [phi]x + (t - sin t)/t^3 [phi]x^2,   t = |phi|.
   static Transformation leftJacobian(const Tangent& phi) {
     using std::sqrt;
-    const Scalar t2 = phi.squaredNorm();
-    const Scalar t = sqrt(t2);
-    const Scalar c = lie::thetaMinusSinOverTheta3(t);
-    // [phi]x^2 = phi phi^T - t^2 I.
-    Transformation J = (Scalar(1) - c * t2) * Transformation::Identity() + lie::oneMinusCosOverTheta2(t) * hat(phi);
-    J.noalias() += c * (phi * phi.transpose());
-    return J;
-  }
-  // Jl(phi) v without forming Jl: v + b (phi x v) + c (phi x (phi x v)) (SE3::exp's translation).
-  static Point leftJacobianTimes(const Tangent& phi, const Point& v) {
-    using std::sqrt;
     const Scalar t = sqrt(phi.squaredNorm());
-    const Point pv = phi.cross(v);
-    return v + lie::oneMinusCosOverTheta2(t) * pv + lie::thetaMinusSinOverTheta3(t) * phi.cross(pv);
+    const Transformation P = hat(phi);
+    return Transformation::Identity() + lie::oneMinusCosOverTheta2(t) * P + lie::thetaMinusSinOverTheta3(t) * P * P;
   }
   // Jl^-1 = I - 1/2 [phi]x + (1/t^2 - (1 + cos t) / (2 t sin t)) [phi]x^2; so log(exp(d) R) =
   // log(R) + Jl^-1(log R) d + O(d^2). Finite up to t = pi.
