@@ -27,14 +27,8 @@ Mat36 dLeftAction(const Vec3& p) {
   return J;
 }
 
-// [I, -[p]x] Jl(d) for SE3's left Jacobian Jl(d) = [J, Q; 0, J] (rsvio/lie/se3.h, d = (upsilon; omega),
-// t = |omega|): [J, Q - [p]x J], without the 3x6 by 6x6 product and with the products of skew
-// matrices of J and Q in closed form ([a]x [b]x = b a^T - (a.b) I, W omega = 0; W = [omega]x,
-// U = [upsilon]x, s = omega . upsilon, x = omega x upsilon, B..E the coefficients of lie_common.h):
-//   J = I + B W + C W^2,   W^2 = omega omega^T - t^2 I,
-//   Q = U / 2 + C (upsilon omega^T + omega upsilon^T - 2 s I - s W) + D (x omega^T - omega x^T + s W)
-//       - 2 E s W^2,
-// the same matrices as se3.h's products (its contract's Q). d = 0 (a global shutter) gives [I, -[p]x].
+// [I, -[p]x] Jl(d) for SE3's left Jacobian Jl(d) = [J, Q; 0, J]: [J, Q - [p]x J], without the
+// 3x6 by 6x6 product. d = 0 (a global shutter) gives [I, -[p]x] exactly.
 Mat36 dLeftActionTimesJl(const Vec3& p, const Vec6& d) {
   Mat36 M;
   if (d.isZero(0.0)) {
@@ -42,20 +36,9 @@ Mat36 dLeftActionTimesJl(const Vec3& p, const Vec6& d) {
     M.rightCols<3>() = -SO3d::hat(p);
     return M;
   }
-  const Vec3 u = d.head<3>(), w = d.tail<3>();
-  const double t2 = w.squaredNorm(), t = std::sqrt(t2);
-  const double B = lie::oneMinusCosOverTheta2(t), C = lie::thetaMinusSinOverTheta3(t);
-  const double D = lie::se3QCoeff2(t), E = lie::se3QCoeff3(t);
-  const Mat3 I = Mat3::Identity();
-  const Mat3 W = SO3d::hat(w);
-  const Mat3 W2 = w * w.transpose() - t2 * I;
-  const double s = w.dot(u);
-  const Vec3 x = w.cross(u);
-  const Mat3 J = I + B * W + C * W2;
-  const Mat3 Q = 0.5 * SO3d::hat(u) + C * (u * w.transpose() + w * u.transpose() - 2.0 * s * I - s * W) +
-                 D * (x * w.transpose() - w * x.transpose() + s * W) - (2.0 * E * s) * W2;
-  M.leftCols<3>() = J;
-  M.rightCols<3>() = Q - SO3d::hat(p) * J;
+  const Mat6 Jl = SE3d::leftJacobian(d);
+  M.leftCols<3>() = Jl.topLeftCorner<3, 3>();
+  M.rightCols<3>() = Jl.topRightCorner<3, 3>() - SO3d::hat(p) * Jl.bottomRightCorner<3, 3>();
   return M;
 }
 

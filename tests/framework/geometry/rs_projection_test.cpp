@@ -243,5 +243,37 @@ TEST_F(RsProjectionTest, SingularOrWildMotionStopsAndReportsFailure) {
   EXPECT_GT(failures, 0);
 }
 
+// TwistExp (rs_projection.h) is exp(xi t) of rsvio/lie/se3.h at every row time: rotation, translation and
+// the point it moves, on the series branch (rolling-shutter angles, ~0.01 rad), on the trigonometric one
+// (above 1 rad), for negative t (host rows above y0), and exactly the identity for a zero twist or
+// t = 0. Held to 1e-14 against SE3d::exp, so a dropped or mis-scaled term of R or p fails it.
+TEST(TwistExpTest, IsTheSe3ExponentialAlongTheRows) {
+  const Vec6 twists[3] = {(Vec6() << 0.6, -0.2, 0.3, 0.4, -0.5, 0.2).finished(),
+                          (Vec6() << 1.5, 0.7, -2.0, 0.9, 1.1, -0.6).finished(),
+                          (Vec6() << 0.3, 0.1, 0.0, 0.0, 0.0, 0.0).finished()};
+  const Vec3 X(0.4, -1.2, 5.0);
+  for (const Vec6& xi : twists) {
+    const TwistExp ex(xi);
+    for (double t : {-0.015, -1e-4, 3e-6, 0.012, 0.8, 2.0}) {
+      const SE3d E = SE3d::exp(xi * t);
+      Mat3 R;
+      Vec3 p;
+      ex.at(t, R, p);
+      EXPECT_LT((R - E.rotationMatrix()).norm(), 1e-14) << "t " << t;
+      EXPECT_LT((p - E.translation()).norm(), 1e-14 * (1.0 + E.translation().norm())) << "t " << t;
+      EXPECT_LT((ex.rotation(t) - E.rotationMatrix()).norm(), 1e-14) << "t " << t;
+      EXPECT_LT((ex.apply(t, X) - E * X).norm(), 1e-13) << "t " << t;
+    }
+  }
+  Mat3 R;
+  Vec3 p;
+  TwistExp(Vec6::Zero()).at(0.01, R, p);
+  EXPECT_EQ(R, Mat3::Identity());
+  EXPECT_EQ(p, Vec3::Zero());
+  TwistExp(twists[0]).at(0.0, R, p);
+  EXPECT_EQ(R, Mat3::Identity());
+  EXPECT_EQ(p, Vec3::Zero());
+}
+
 }  // namespace
 }  // namespace rsvio::test
