@@ -386,10 +386,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
           }
           for (int c = 0; c < 4; ++c) {
             const int rc = row[aidx[c]];
-            if (ra <= rc)
-              Hd[static_cast<Eigen::Index>(rc) * ld + ra] += Hga(a, c);
-            else
-              Hd[static_cast<Eigen::Index>(ra) * ld + rc] += Hga(a, c);
+            Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hga(a, c);
           }
           hcol[ga] = Hgg(a, ID);
           cs.b[ra] += bg[a];
