@@ -183,8 +183,9 @@ TEST(SmoothMotionTerm, OneKeyframesTermIsItsShareOfTheWindowSystem) {
 // Scaling W_f by s scales every residual's translation by s (log(T_b T_a^-1) and the twist velocity
 // both scale), so E(s) = s^2 E_t + E_r and dE/ds = 2 E_t along the monocular scale direction n
 // (window.h scaleDirection). The normal equations must say the same, -2 b.n = 2 E_t: an identity that
-// checks the pose and twist Jacobians along the translations as a whole (a pose Jacobian off by 0.8x
-// fails it). It is also why the term is handed to the prior scale-free (smooth_motion_term.h).
+// checks the pose and twist Jacobians along the translations as a whole (a scaled pose Jacobian breaks
+// it by construction; not run as a mutation). It is also why the term is handed to the prior
+// scale-free (smooth_motion_term.h).
 TEST(SmoothMotionTerm, NormalEquationsAlongTheScaleAreTheEnergysScaleDerivative) {
   Chain c;
   const SmoothMotionTerm term(options());
