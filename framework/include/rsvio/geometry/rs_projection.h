@@ -26,6 +26,7 @@
 // - Batch calls: one call per host-target pair; each Newton iteration is one camera batch call.
 #pragma once
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 #include "rsvio/core/types.h"
@@ -44,7 +45,6 @@ using Mat26 = Eigen::Matrix<double, 2, 6>;
 //   R(t) = I + t a W + t^2 b W^2,   p(t) = Jl(omega t) v t = t v + t^2 b (W v) + t^3 c (W W v),
 // the same as SE3d::exp(xi * t) (rsvio/lie/se3.h), with W, W^2, W v and W W v formed once per twist.
 struct TwistExp {
-  TwistExp() = default;
   Mat3 W = Mat3::Zero(), W2 = Mat3::Zero();
   Vec3 v = Vec3::Zero(), Wv = Vec3::Zero(), WWv = Vec3::Zero();
   double theta = 0.0;
@@ -66,17 +66,16 @@ struct TwistExp {
       p.setZero();
       return;
     }
-    const double phi = theta * t < 0.0 ? -theta * t : theta * t;
-    const double a = t * lie::sinOverTheta(phi), b = t * t * lie::oneMinusCosOverTheta2(phi);
-    const double c = t * t * t * lie::thetaMinusSinOverTheta3(phi);
-    R = Mat3::Identity() + a * W + b * W2;
-    p = t * v + b * Wv + c * WWv;
+    const double phi = std::abs(theta * t);
+    const double b = t * t * lie::oneMinusCosOverTheta2(phi);
+    R = rotationAt(t, phi, b);
+    p = t * v + b * Wv + (t * t * t * lie::thetaMinusSinOverTheta3(phi)) * WWv;
   }
   // The rotation alone.
   Mat3 rotation(double t) const {
     if (zero || t == 0.0) return Mat3::Identity();
-    const double phi = theta * t < 0.0 ? -theta * t : theta * t;
-    return Mat3::Identity() + (t * lie::sinOverTheta(phi)) * W + (t * t * lie::oneMinusCosOverTheta2(phi)) * W2;
+    const double phi = std::abs(theta * t);
+    return rotationAt(t, phi, t * t * lie::oneMinusCosOverTheta2(phi));
   }
   // exp(xi t) applied to a point.
   Vec3 apply(double t, const Vec3& X) const {
@@ -84,6 +83,12 @@ struct TwistExp {
     Vec3 p;
     at(t, R, p);
     return R * X + p;
+  }
+
+ private:
+  // R(t) = I + t a W + t^2 b W^2 with b_t = t^2 b given (at() needs it for p too).
+  Mat3 rotationAt(double t, double phi, double b_t) const {
+    return Mat3::Identity() + (t * lie::sinOverTheta(phi)) * W + b_t * W2;
   }
 };
 
