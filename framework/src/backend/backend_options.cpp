@@ -67,6 +67,10 @@ ParamTable backendParamTable() {
                "(0: the start ignores the readout)"),
       paramBool("init_keyframe_twist", d.init_keyframe_twist,
                 "rolling shutter: the first keyframe starts with the two-view start's twist (else 0)"),
+      paramBool("init_rotation_rates", d.init_rotation_rates,
+                "rolling shutter: the two-view start rotates each image's corners to its central pose with the "
+                "image's own rotation rate, measured from its neighbour frames, and the first two keyframes "
+                "start with those rates (off: the readout is ignored or init_rolling_shutter_iterations)"),
       paramInt("max_lost_frames", d.max_lost_frames, 0, 1000, "",
                "consecutive frames the tracker may lose before the run fails"),
       paramDouble("fail_max_rmse", d.fail_max_rmse, 0.0, 1e6, "intensity",
@@ -112,6 +116,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.init_corners = static_cast<int>(p.getInt("init_corners"));
   o.init_rolling_shutter_iterations = static_cast<int>(p.getInt("init_rolling_shutter_iterations"));
   o.init_keyframe_twist = p.getBool("init_keyframe_twist");
+  o.init_rotation_rates = p.getBool("init_rotation_rates");
   o.max_lost_frames = static_cast<int>(p.getInt("max_lost_frames"));
   o.fail_max_rmse = p.getDouble("fail_max_rmse");
   o.fail_min_inlier_ratio = p.getDouble("fail_min_inlier_ratio");

@@ -2,6 +2,7 @@
 // (contract in rsvio/backend/mono_initializer.h).
 #include "rsvio/backend/mono_initializer.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -163,6 +164,48 @@ bool triangulate(const Mat3d& R, const Eigen::Vector3d& t, const Eigen::Vector3d
 
 }  // namespace
 
+bool fitRotationRate(const std::vector<Eigen::Vector3d>& a, const std::vector<double>& tau_a,
+                     const std::vector<Eigen::Vector3d>& b, const std::vector<double>& tau_b, double dt,
+                     Eigen::Vector3d* w) {
+  const size_t n = std::min({a.size(), b.size(), tau_a.size(), tau_b.size()});
+  std::vector<uint8_t> use(n, 1);
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  // r_k = b_k - exp([w] dt_k) a_k; d r_k / d w = [p_k]x dt_k with p_k = exp([w] dt_k) a_k (left
+  // perturbation of the rotation, to first order).
+  auto solve = [&](int rounds) {
+    for (int it = 0; it < rounds; ++it) {
+      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d g = Eigen::Vector3d::Zero();
+      int used = 0;
+      for (size_t k = 0; k < n; ++k) {
+        if (!use[k]) continue;
+        const double dk = dt + tau_b[k] - tau_a[k];
+        const Eigen::Vector3d p = SO3d::exp(x * dk) * a[k];
+        const Eigen::Matrix3d J = SO3d::hat(p) * dk;
+        const Eigen::Vector3d r = b[k] - p;
+        H += J.transpose() * J;
+        g += J.transpose() * r;
+        ++used;
+      }
+      if (used < 8) return false;
+      Eigen::LDLT<Eigen::Matrix3d> ldlt(H);
+      if (ldlt.info() != Eigen::Success || !(H.trace() > 0.0)) return false;
+      const Eigen::Vector3d dx = ldlt.solve(-g);
+      if (!dx.allFinite()) return false;
+      x += dx;
+    }
+    return true;
+  };
+  if (n < 8 || !solve(3)) return false;
+  std::vector<double> res(n);
+  for (size_t k = 0; k < n; ++k) res[k] = (b[k] - SO3d::exp(x * (dt + tau_b[k] - tau_a[k])) * a[k]).norm();
+  const double lim = 3.0 * median(res);
+  for (size_t k = 0; k < n; ++k) use[k] = res[k] <= lim ? 1 : 0;
+  if (!solve(2)) return false;
+  *w = x;
+  return true;
+}
+
 MonoInitializer::MonoInitializer(const BackendOptions& options, const CameraModel& camera, const RowTiming& timing)
     : options_(options), camera_(camera), timing_(timing) {}
 
@@ -180,6 +223,8 @@ void MonoInitializer::reset(int64_t frame_index, int64_t t_ns) {
   cv::goodFeaturesToTrack(img8, corners, options_.init_corners, 0.01, std::max(3.0, diag / 60.0), mask, 5);
   ref_pts_ = corners;
   cur_pts_ = corners;
+  hist_pts_.assign(1, corners);
+  hist_t_ns_.assign(1, t_ns);
   initial_tracks_ = static_cast<int>(corners.size());
   ref_index_ = frame_index;
   ref_t_ns_ = t_ns;
@@ -196,6 +241,7 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
   }
   // Frame-to-frame tracks with a forward-backward check.
   std::vector<cv::Point2f> ref_kept, cur_kept;
+  std::vector<size_t> kept;
   for (size_t i = 0; i < cur_pts_.size(); ++i) {
     const Vec2 p(cur_pts_[i].x, cur_pts_[i].y);
     Vec2 q, back;
@@ -203,9 +249,18 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
     if (!trackPoint(*pyramid, *prev_, q, p, &back) || (back - p).norm() > 1.0) continue;
     ref_kept.push_back(ref_pts_[i]);
     cur_kept.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
+    kept.push_back(i);
   }
   ref_pts_.swap(ref_kept);
   cur_pts_.swap(cur_kept);
+  for (std::vector<cv::Point2f>& h : hist_pts_) {
+    std::vector<cv::Point2f> hk;
+    hk.reserve(kept.size());
+    for (size_t i : kept) hk.push_back(h[i]);
+    h.swap(hk);
+  }
+  hist_pts_.push_back(cur_pts_);
+  hist_t_ns_.push_back(t_ns);
   prev_ = std::move(pyramid);
   ++frames_since_ref_;
   if (static_cast<int>(cur_pts_.size()) < std::max(30, initial_tracks_ / 3)) {
@@ -238,6 +293,11 @@ bool MonoInitializer::tryInitialise() {
   }
   TwoViewOptions tvo;
   tvo.rolling_shutter_iterations = options_.init_rolling_shutter_iterations;
+  // Each image's rotation rate needs two frame pairs at each end (with 3 frames after the reference
+  // the two ends share their middle pair).
+  const int last = static_cast<int>(hist_pts_.size()) - 1;
+  if (options_.init_rotation_rates && timing_.dtDv() != 0.0 && last >= 3)
+    tvo.use_rates = rateAt(0, 0, &tvo.w_ref) && rateAt(last - 2, last, &tvo.w_cur);
   const TwoViewResult r = solveTwoView(ref_px, cur_px, camera_, timing_, nsToS(cur_t_ns_ - ref_t_ns_),
                                        0x5eed1234u + static_cast<uint64_t>(ref_index_), tvo);
   status_ = r.status;
@@ -248,7 +308,49 @@ bool MonoInitializer::tryInitialise() {
     return false;
   T_cur_ref_ = r.T_cur_ref;
   xi_ = r.xi;
+  rates_used_ = tvo.use_rates;
+  xi_ref_ = tvo.use_rates ? r.xi_ref : r.xi;
+  xi_cur_ = tvo.use_rates ? r.xi_cur : r.xi;
   return true;
+}
+
+bool MonoInitializer::rateAt(int i0, int at, Eigen::Vector3d* w) const {
+  auto pairRate = [&](int i, Eigen::Vector3d* out) {
+    const std::vector<cv::Point2f>& pa = hist_pts_[static_cast<size_t>(i)];
+    const std::vector<cv::Point2f>& pb = hist_pts_[static_cast<size_t>(i) + 1];
+    const Eigen::Index n = static_cast<Eigen::Index>(pa.size());
+    Eigen::Matrix2Xd ua(2, n), ub(2, n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      ua.col(k) << pa[static_cast<size_t>(k)].x, pa[static_cast<size_t>(k)].y;
+      ub.col(k) << pb[static_cast<size_t>(k)].x, pb[static_cast<size_t>(k)].y;
+    }
+    Eigen::Matrix3Xd ba, bb;
+    std::vector<uint8_t> va, vb;
+    camera_.unproject(ua, ba, va);
+    camera_.unproject(ub, bb, vb);
+    std::vector<Eigen::Vector3d> a, b;
+    std::vector<double> ta, tb;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (!va[static_cast<size_t>(k)] || !vb[static_cast<size_t>(k)]) continue;
+      a.push_back(ba.col(k).normalized());
+      b.push_back(bb.col(k).normalized());
+      ta.push_back(timing_.rowTime(ua(1, k)));
+      tb.push_back(timing_.rowTime(ub(1, k)));
+    }
+    const double dt = nsToS(hist_t_ns_[static_cast<size_t>(i) + 1] - hist_t_ns_[static_cast<size_t>(i)]);
+    return dt > 0.0 && fitRotationRate(a, ta, b, tb, dt, out);
+  };
+  Eigen::Vector3d w0, w1;
+  if (!pairRate(i0, &w0) || !pairRate(i0 + 1, &w1)) return false;
+  // Each pair's rate belongs to the middle of its interval; the line through both, at the image's time.
+  auto mid = [&](int i) {
+    return 0.5 * nsToS(hist_t_ns_[static_cast<size_t>(i)] - hist_t_ns_[0]) +
+           0.5 * nsToS(hist_t_ns_[static_cast<size_t>(i) + 1] - hist_t_ns_[0]);
+  };
+  const double m0 = mid(i0), m1 = mid(i0 + 1), t = nsToS(hist_t_ns_[static_cast<size_t>(at)] - hist_t_ns_[0]);
+  if (!(m1 > m0)) return false;
+  *w = w0 + (w1 - w0) * ((t - m0) / (m1 - m0));
+  return w->allFinite();
 }
 
 namespace {
@@ -372,6 +474,16 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
       x2[i] = B2[i].head<2>() / B2[i].z();
     }
   };
+  const bool rates = options.use_rates && timing.dtDv() != 0.0;
+  if (rates) {
+    // Each bearing rotated to its image's central pose with the image's own rotation rate: a bearing
+    // read at row time tau is exp([w] tau) times its direction at the central pose.
+    for (size_t i = 0; i < static_cast<size_t>(m); ++i) {
+      B1[i] = SO3d::exp(-options.w_ref * tau1[i]) * R1[i];
+      B2[i] = SO3d::exp(-options.w_cur * tau2[i]) * R2[i];
+    }
+    toPlane();
+  }
   const double f = camera.calibration().intrinsics[0] > 0 ? camera.calibration().intrinsics[0] : 500.0;
   const double thr = (1.0 / f) * (1.0 / f);
   std::mt19937_64 rng(seed);
@@ -403,7 +515,7 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
   // line delay of 0) skips this: every row time is 0.
   Vec6 xi = Vec6::Zero();
   const bool rolling = timing.dtDv() != 0.0 && dt_s > 0.0;
-  for (int k = 0; rolling && k < options.rolling_shutter_iterations; ++k) {
+  for (int k = 0; rolling && !rates && k < options.rolling_shutter_iterations; ++k) {
     xi = SE3d(fit.R, fit.t).log() / dt_s;
     for (size_t i = 0; i < static_cast<size_t>(m); ++i) {
       B1[i] = toCentralPose(R1[i], fit.d1[i], xi, tau1[i]);
@@ -419,7 +531,10 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
   std::ostringstream os;
   os << "essential matrix: " << fit.in.size() << "/" << m << " inliers, " << fit.front << " in front, median parallax "
      << r.parallax_deg << " deg";
-  if (rolling && options.rolling_shutter_iterations > 0) os << ", rolling shutter corrected";
+  if (rates)
+    os << ", rolling shutter corrected with each image's rotation rate";
+  else if (rolling && options.rolling_shutter_iterations > 0)
+    os << ", rolling shutter corrected";
   r.status = os.str();
   std::vector<double> depth;
   for (int i : fit.in)
@@ -429,6 +544,10 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
   if (depth.empty() || !(med_depth > 0)) return r;
   r.T_cur_ref = SE3d(Eigen::Quaterniond(fit.R).normalized(), fit.t / med_depth);
   if (rolling && dt_s > 0) r.xi = r.T_cur_ref.log() / dt_s;
+  if (rates) {
+    r.xi_ref << r.xi.head<3>(), options.w_ref;
+    r.xi_cur << r.xi.head<3>(), options.w_cur;
+  }
   r.found = true;
   return r;
 }

@@ -46,6 +46,10 @@ class MonoStart {
   const StartFrame& reference() const { return frames_.front(); }
   const SE3d& T_cur_ref() const { return initializer_.T_cur_ref(); }
   const Vec6& xi() const { return initializer_.xi(); }  // both frames' twist (rolling shutter), else 0
+  // Each frame's own twist (rolling shutter with backend.init_rotation_rates; else both xi()).
+  bool ratesUsed() const { return initializer_.ratesUsed(); }
+  const Vec6& xiRef() const { return initializer_.xiRef(); }
+  const Vec6& xiCur() const { return initializer_.xiCur(); }
   const std::string& status() const { return initializer_.status(); }
   void clear() { frames_.clear(); }
 

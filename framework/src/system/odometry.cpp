@@ -227,7 +227,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
 // candidates, marginalise the flagged keyframes, check for divergence.
 void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms,
                                   std::shared_ptr<const ImagePyramid> pyr, const SE3d& T_c_w,
-                                  const AffineBrightness& affine) {
+                                  const AffineBrightness& affine, const Vec6* twist_start) {
   const std::vector<Keyframe*> flagged = window->keyframesToMarginalize();
   auto kf = std::make_unique<Keyframe>();
   kf->frame_index = frame_index;
@@ -237,7 +237,7 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
   kf->state.T_c_w = T_c_w;
   kf->state.affine = affine;
   if (rolling) {
-    kf->state.twist = tracking->velocityEstimate();
+    kf->state.twist = twist_start ? *twist_start : tracking->velocityEstimate();
     kf->twist_start = kf->state.twist;
     MotionState ms;
     ms.t_ns = t_ns;
@@ -360,10 +360,13 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   kf0->t_ns = ref.t_ns;
   kf0->exposure_ms = ref.exposure_ms;
   kf0->pyramid = ref.pyramid;
-  // Rolling shutter: both frames start with the two-view start's constant twist (mono_initializer.h);
-  // keyframe 1 gets it from the tracking history (the same velocity, ref and cur being its two entries).
-  if (rolling && bo.init_keyframe_twist) {
-    kf0->state.twist = start->xi();
+  // Rolling shutter: with init_rotation_rates each frame starts with its own twist from the two-view
+  // start (its rotation rate measured from its neighbour frames, mono_initializer.h); else, with
+  // init_keyframe_twist, keyframe 0 starts with the start's constant twist and keyframe 1 gets it from
+  // the tracking history (the same velocity, ref and cur being its two entries).
+  const bool own_twists = rolling && start->ratesUsed();
+  if (own_twists || (rolling && bo.init_keyframe_twist)) {
+    kf0->state.twist = own_twists ? start->xiRef() : start->xi();
     kf0->twist_start = kf0->state.twist;
   }
   Keyframe& k0 = window->insert(std::move(kf0));  // the first keyframe: the gauge
@@ -385,7 +388,9 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   rec.T_f_ref = T_cur_ref;
   record->addFrame(rec);
   tracking->pushHistory(rec.t_ns, rec.T_c_w, rec.keyframe);
-  makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, pyr, T_cur_ref, AffineBrightness());
+  const Vec6 xi_cur = start->xiCur();
+  makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, pyr, T_cur_ref, AffineBrightness(),
+               own_twists ? &xi_cur : nullptr);
   initialized = true;
   if (failed) return FrameStatus{false, true, "failed: " + failure};
 

@@ -75,7 +75,7 @@ struct Odometry::Impl {
   FrameStatus initialise(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr, const cv::Mat& working);
   FrameStatus track(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr);
   void makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms, std::shared_ptr<const ImagePyramid> pyr,
-                    const SE3d& T_c_w, const AffineBrightness& affine);
+                    const SE3d& T_c_w, const AffineBrightness& affine, const Vec6* twist_start = nullptr);
   void checkDivergence();
   // An estimated line delay: the window's current value to the timing the tracker and record use.
   void syncLineDelay();

@@ -61,10 +61,12 @@ TEST(VisualInertial, TinyGlobalShutterSequenceGetsMetricScaleAndGravity) {
   EXPECT_GT(r.vio.at("scale").get<double>(), 0.0);
 }
 
-// The paper's method on the tiny rolling-shutter sequence with the true line delay.
+// The paper's method on the tiny rolling-shutter sequence with the true line delay, after the plain
+// two-view start (tiny_rs's 0.15 s start is too short for the rate-corrected one: odometry_test.cpp).
 TEST(VisualInertial, TinyRollingShutterSequenceWithTwistEnergy) {
   const std::string data = simDataset("tiny_rs");
-  const VioOutcome r = runVio(data, runConfig("rs_vio", {"shutter.params.line_delay_us=117.88"}));
+  const VioOutcome r = runVio(data, runConfig("rs_vio", {"shutter.params.line_delay_us=117.88",
+                                                         "backend.init_rotation_rates=false"}));
   ASSERT_FALSE(r.failed) << r.reason;
   ASSERT_TRUE(r.vio.at("initialised").get<bool>()) << r.vio.dump();
   EXPECT_EQ(r.untracked_after_first, 0);

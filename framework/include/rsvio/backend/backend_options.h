@@ -52,6 +52,8 @@ struct BackendOptions {
   int init_corners = 400;             // corners tracked with pyramidal Lucas-Kanade
   int init_rolling_shutter_iterations = 0;  // two-view rounds with the corners at their row times (mono_initializer.h)
   bool init_keyframe_twist = false;   // rolling shutter: keyframe 0 starts with the two-view twist
+  bool init_rotation_rates = true;    // rolling shutter: each start image's rotation rate from its
+                                      // neighbour frames (mono_initializer.h); the keyframes start with it
   // Divergence detection (the run ends "failed" with the reason).
   int max_lost_frames = 3;            // consecutive frames the tracker loses
   double fail_max_rmse = 40.0;        // BA RMSE per pattern pixel, intensity units

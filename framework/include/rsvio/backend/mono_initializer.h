@@ -28,6 +28,18 @@
 //   handed on (xi()) as the start of keyframe 0's twist (default off). On exact correspondences the
 //   rounds remove the readout's bias (tests/framework/backend/two_view_test.cpp), but on the demo
 //   sequences the bias is below the corner noise and the runs did not improve: docs/rolling_shutter.md.
+// - Rolling shutter, each image's own rotation rate (init_rotation_rates, default on): over a
+//   0.3-0.5 s start the rotation rate of handheld motion can change by more than its mean, so one
+//   constant twist for both images cannot remove the readout's shear, and that shear (10-12 px over
+//   the image at 0.9 rad/s and 30 ms) can exceed the translation's parallax: the essential matrix then
+//   explains the shear as translation. Each image's rate is measured from its neighbour frames
+//   instead (fitRotationRate: the corner tracks of two consecutive frames, 50 ms apart, where the
+//   rotation dominates the flow; two consecutive pairs give the rate's trend, extrapolated to the
+//   image's timestamp; from the 3rd frame after the reference on), every bearing is rotated to its
+//   image's central pose with that rate (exp(-[w] tau), no depth needed), and the essential matrix is
+//   fitted on those bearings. The rounds above are then not run (they would put one average twist
+//   back). xiRef() and xiCur() hand the images' twists on: the measured rates and the fit's average
+//   translation velocity. Figures: docs/rolling_shutter.md, "The start".
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -47,12 +59,18 @@ class CameraModel;
 struct TwoViewOptions {
   int rolling_shutter_iterations = 3;  // rounds of moving the bearings to the central poses (the odometry
                                        // passes backend.init_rolling_shutter_iterations, default 0)
+  // Rolling shutter: each image's rotation rate (rad/s, the rotation part of a twist, left form), used
+  // to rotate its bearings to its central pose before the fit; then the rounds above are not run.
+  bool use_rates = false;
+  Eigen::Vector3d w_ref = Eigen::Vector3d::Zero(), w_cur = Eigen::Vector3d::Zero();
 };
 
 struct TwoViewResult {
   bool found = false;       // a pose with depths (the caller applies the acceptance checks)
   SE3d T_cur_ref;           // camera_cur from camera_ref, median inlier depth in the reference 1
   Vec6 xi = Vec6::Zero();   // the constant twist per second between the timestamps (0 for a global shutter)
+  Vec6 xi_ref = Vec6::Zero(), xi_cur = Vec6::Zero();  // with use_rates: each image's twist (its rate,
+                                                      // the fit's average translation velocity)
   int correspondences = 0;  // with valid bearings in both images
   int inliers = 0, front = 0, num_depths = 0;
   double inlier_ratio = 0.0, parallax_deg = 0.0;
@@ -64,6 +82,18 @@ struct TwoViewResult {
 // delay, and the pose. dt_s: timestamp of cur minus that of ref. Deterministic for a given seed.
 TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Vec2>& cur_px, const CameraModel& camera,
                            const RowTiming& timing, double dt_s, uint64_t seed, const TwoViewOptions& options);
+
+// The rotation rate w (rad/s; left form, camera coordinates at time t are exp([w] t) times those at
+// 0, the rotation part of a twist) that carries the bearings `a` of one image to the bearings `b` of a
+// later image of the same static points, translation neglected (right over one frame interval, where
+// the rotation dominates the flow): b_k = exp([w] dt_k) a_k with dt_k = dt + tau_b[k] - tau_a[k], each
+// bearing at its own row's time (tau, relative to its image's timestamp; dt: timestamp of b minus that
+// of a). Gauss-Newton from 0 on the bearings' differences, 3 rounds, then once more without the
+// bearings whose residual exceeds 3 times the median (KLT slips). Returns false with fewer than 8
+// bearings or a singular system.
+bool fitRotationRate(const std::vector<Eigen::Vector3d>& a, const std::vector<double>& tau_a,
+                     const std::vector<Eigen::Vector3d>& b, const std::vector<double>& tau_b, double dt,
+                     Eigen::Vector3d* w);
 
 class MonoInitializer {
  public:
@@ -80,6 +110,11 @@ class MonoInitializer {
   int framesSinceReference() const { return frames_since_ref_; }
   const SE3d& T_cur_ref() const { return T_cur_ref_; }
   const Vec6& xi() const { return xi_; }  // twist per second of both frames (rolling shutter), else 0
+  // With init_rotation_rates on a rolling shutter: each image's own twist (else both xi()), and
+  // whether the start used them (from the 3rd frame after the reference on).
+  bool ratesUsed() const { return rates_used_; }
+  const Vec6& xiRef() const { return xi_ref_; }
+  const Vec6& xiCur() const { return xi_cur_; }
   double medianParallaxDeg() const { return parallax_deg_; }
   const std::string& status() const { return status_; }  // one line: what the last attempt found
   int numTracks() const { return static_cast<int>(cur_pts_.size()); }
@@ -87,6 +122,9 @@ class MonoInitializer {
  private:
   void reset(int64_t frame_index, int64_t t_ns);
   bool tryInitialise();
+  // Rotation rate of the image at history index `at`, from the frame pairs (i0, i0 + 1) and (i0 + 1,
+  // i0 + 2), linearly extrapolated in time to that image's timestamp.
+  bool rateAt(int i0, int at, Eigen::Vector3d* w) const;
 
   BackendOptions options_;
   const CameraModel& camera_;
@@ -96,9 +134,14 @@ class MonoInitializer {
   int initial_tracks_ = 0;
   std::shared_ptr<const ImagePyramid> prev_;
   std::vector<cv::Point2f> ref_pts_, cur_pts_;
+  // Every frame's positions of the surviving tracks since the reference (hist_pts_[0] = ref_pts_,
+  // back() = cur_pts_) and their timestamps, for the rotation rates.
+  std::vector<std::vector<cv::Point2f>> hist_pts_;
+  std::vector<int64_t> hist_t_ns_;
   SE3d T_cur_ref_;
-  Vec6 xi_ = Vec6::Zero();
+  Vec6 xi_ = Vec6::Zero(), xi_ref_ = Vec6::Zero(), xi_cur_ = Vec6::Zero();
   double parallax_deg_ = 0.0;
+  bool rates_used_ = false;
   std::string status_;
 };
 
