@@ -376,7 +376,8 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   }
   window->createCandidates(k0);
   CandidateFrame target;
-  target.pose = RsFrame{T_cur_ref, k0.state.twist};  // the two-view twist, or 0
+  // The current frame's twist: its own (init_rotation_rates), else the two-view twist, or 0.
+  target.pose = RsFrame{T_cur_ref, own_twists ? start->xiCur() : k0.state.twist};
   target.exposure_ms = frame.exposure_ms;
   window->traceCandidates(target, pyr->level(0));
   record->recordKeyframe(k0);
