@@ -29,7 +29,7 @@ void BlockRunner::workerLoop() {
       job = job_;
       n = num_blocks_;
     }
-    for (int b = 1; b < n; b += 2) (*job)(b);
+    for (int b; (b = next_.fetch_add(1, std::memory_order_relaxed)) < n;) (*job)(b);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       worker_busy_ = false;
@@ -48,10 +48,11 @@ void BlockRunner::run(int num_blocks, const std::function<void(int)>& f) {
     job_ = &f;
     num_blocks_ = num_blocks;
     worker_busy_ = true;
+    next_.store(0, std::memory_order_relaxed);
     ++generation_;
   }
   wake_.notify_one();
-  for (int b = 0; b < num_blocks; b += 2) f(b);
+  for (int b; (b = next_.fetch_add(1, std::memory_order_relaxed)) < num_blocks;) f(b);
   std::unique_lock<std::mutex> lock(mutex_);
   done_.wait(lock, [&] { return !worker_busy_; });
   job_ = nullptr;

@@ -52,6 +52,7 @@ KeyframeWindow::KeyframeWindow(const WindowSetup& setup, const CameraModel& came
       camera_(camera),
       timing_(timing) {
   tracer_ = std::make_unique<CandidateTracer>(fo_.trace, fo_.residual, camera_, timing_);
+  runner_ = std::make_unique<BlockRunner>(setup.ba.threads);
   ba_ = std::make_unique<BundleAdjuster>(setup.ba, camera_, timing_, solver);
   if (rolling_ && setup.smooth_motion) {
     SmoothMotionOptions so;
@@ -141,14 +142,17 @@ double KeyframeWindow::medianIdepth() const {
 }
 
 void KeyframeWindow::traceCandidates(const CandidateFrame& target, const ImageLevel& target_level0) {
-  for (auto& kf : window_) {
-    if (kf->candidates.empty()) continue;
+  // One block per host keyframe: each writes only its own candidates, so the result does not depend
+  // on the thread count or on which thread ran which host.
+  runner_->run(static_cast<int>(window_.size()), [&](int i) {
+    Keyframe& kf = *window_[static_cast<size_t>(i)];
+    if (kf.candidates.empty()) return;
     CandidateFrame host;
-    host.pose = rsFrame(*kf, rolling_);
-    host.affine = kf->state.affine;
-    host.exposure_ms = kf->exposure_ms;
-    tracer_->trace(kf->candidates, host, target, target_level0);
-  }
+    host.pose = rsFrame(kf, rolling_);
+    host.affine = kf.state.affine;
+    host.exposure_ms = kf.exposure_ms;
+    tracer_->trace(kf.candidates, host, target, target_level0);
+  });
 }
 
 void KeyframeWindow::createCandidates(Keyframe& kf) {

@@ -36,6 +36,7 @@
 #include "rsvio/backend/dynamic_marginalization.h"
 #include "rsvio/backend/smooth_motion_term.h"
 #include "rsvio/backend/window.h"
+#include "rsvio/frontend/block_runner.h"
 #include "rsvio/frontend/candidate_points.h"
 #include "rsvio/frontend/frame_tracker.h"
 #include "rsvio/frontend/frontend_options.h"
@@ -146,6 +147,7 @@ class KeyframeWindow {
   RowTiming timing_;
   GlobalStates globals_;
   std::unique_ptr<CandidateTracer> tracer_;
+  std::unique_ptr<BlockRunner> runner_;  // candidate tracing, one block per host keyframe
   std::unique_ptr<BundleAdjuster> ba_;
   std::unique_ptr<SmoothMotionTerm> smooth_motion_;  // rolling shutter with a smooth-motion prior, else null
   std::unique_ptr<DynamicMarginalization> prior_;  // its active() prior is the bundle adjuster's

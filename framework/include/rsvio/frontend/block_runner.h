@@ -2,12 +2,14 @@
 //
 // Contract
 // - run(n, f) calls f(b) exactly once for every b in [0, n) and returns when all calls are done.
-//   With two threads the calling thread takes the even blocks and one persistent worker the odd ones.
+//   With two threads the calling thread and one persistent worker take the next block not yet taken
+//   (an atomic counter), so blocks of unequal cost balance; which thread ran a block is not fixed.
 // - Callers make results independent of the thread count by giving every block its own output and
 //   combining them in block order afterwards (conventions.md, "Determinism": parallel sums in a fixed
 //   order). f must not throw; a block that fails records it in its own output.
 // - One run at a time per runner (it is not re-entrant); the worker sleeps between runs.
 #pragma once
+#include <atomic>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -34,6 +36,7 @@ class BlockRunner {
   std::condition_variable done_;
   const std::function<void(int)>* job_ = nullptr;
   int num_blocks_ = 0;
+  std::atomic<int> next_{0};  // the next block to take
   long generation_ = 0;
   bool worker_busy_ = false;
   bool stop_ = false;
