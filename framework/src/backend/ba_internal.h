@@ -99,6 +99,8 @@ struct BundleAdjuster::Impl {
   // Linearisations: current (accepted) and trial.
   Linearization cur, trial;
   std::vector<ChunkSums> chunks;
+  Eigen::MatrixXd probe_H;              // scratch of ba::cameraTermsEnergy
+  Eigen::VectorXd probe_b;
   const MarginalizationPrior* prior = nullptr;
   GlobalStates* globals = nullptr;      // visual-inertial: updated with the keyframes
 };

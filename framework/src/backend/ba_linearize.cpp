@@ -443,14 +443,34 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
 
 }  // namespace
 
-void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                          const CameraModel& camera, const RowTiming& timing, bool points_only) {
+void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                         const CameraModel& camera, const RowTiming& timing) {
   const ResidualKernel kernel(cfg.residual);
   // The line delay being estimated is the globals' (the given timing's otherwise).
   m.timing = timing;
   if (m.gl >= 0 && m.globals) m.timing.line_delay_s = m.globals->state.line_delay_s;
   m.runner->run(static_cast<int>(m.pairs.size()),
                 [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, m.timing, kernel); });
+}
+
+double photometricEnergy(const BundleAdjuster::Impl& m, const Linearization& L) {
+  // The sums of accumulateChunk (per chunk, points in order, their observations in order) and of the
+  // chunks in order after it: the same bits as L.energy_photo of the full accumulation.
+  const int np = static_cast<int>(m.points.size());
+  double total = 0.0;
+  for (int chunk = 0; chunk < kPointChunks; ++chunk) {
+    const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
+    const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+    double e = 0.0;
+    for (int r = m.point_obs_begin[static_cast<size_t>(begin)]; r < m.point_obs_begin[static_cast<size_t>(end)]; ++r)
+      e += L.obs[static_cast<size_t>(r)].energy;
+    total += e;
+  }
+  return total;
+}
+
+void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                           bool points_only) {
   if (points_only) {
     if (cfg.layout.rolling)
       m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, false, true>(m, L, c); });
@@ -500,6 +520,12 @@ void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundl
   }
 }
 
+void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                          const CameraModel& camera, const RowTiming& timing, bool points_only) {
+  evaluatePhotometric(m, L, cfg, camera, timing);
+  accumulatePhotometric(m, L, cfg, points_only);
+}
+
 double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
                       Eigen::Ref<Eigen::VectorXd> b) {
   double e = 0.0;
@@ -529,15 +555,31 @@ double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eig
   return e;
 }
 
-void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                    const std::vector<const WindowTerm*>& terms) {
+namespace {
+
+double addCameraTermsTo(BundleAdjuster::Impl& m, const BundleAdjustmentConfig& cfg,
+                        const std::vector<const WindowTerm*>& terms, Eigen::MatrixXd& H, Eigen::VectorXd& b) {
   const int kd = cfg.layout.kfDim();
   double e = 0.0;
   for (auto& kf : *m.window)
-    e += keyframePriors(*kf, cfg, L.Hcc.block(kf->index * kd, kf->index * kd, kd, kd), L.bc.segment(kf->index * kd, kd));
-  if (m.prior) e += m.prior->addTo(L.Hcc, L.bc);
-  for (const WindowTerm* t : terms) e += t->linearize(*m.window, cfg.layout, L.Hcc, L.bc);
-  L.energy_other = e;
+    e += keyframePriors(*kf, cfg, H.block(kf->index * kd, kf->index * kd, kd, kd), b.segment(kf->index * kd, kd));
+  if (m.prior) e += m.prior->addTo(H, b);
+  for (const WindowTerm* t : terms) e += t->linearize(*m.window, cfg.layout, H, b);
+  return e;
+}
+
+}  // namespace
+
+void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                    const std::vector<const WindowTerm*>& terms) {
+  L.energy_other = addCameraTermsTo(m, cfg, terms, L.Hcc, L.bc);
+}
+
+double cameraTermsEnergy(BundleAdjuster::Impl& m, const BundleAdjustmentConfig& cfg,
+                         const std::vector<const WindowTerm*>& terms) {
+  m.probe_H.setZero(m.nc, m.nc);
+  m.probe_b.setZero(m.nc);
+  return addCameraTermsTo(m, cfg, terms, m.probe_H, m.probe_b);
 }
 
 }  // namespace ba

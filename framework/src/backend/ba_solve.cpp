@@ -19,6 +19,17 @@ void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundl
                           const CameraModel& camera, const RowTiming& timing, bool points_only = false);
 void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
                     const std::vector<const WindowTerm*>& terms);
+// linearizePhotometric in two halves: the residuals, weights and Jacobians of every observation
+// (evaluatePhotometric), then the per-point and camera blocks from them (accumulatePhotometric).
+void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                         const CameraModel& camera, const RowTiming& timing);
+void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                           bool points_only);
+// The energies alone, bit-identical to L.energy_photo and L.energy_other of the full linearisation: a
+// trial step is judged on them, and only an accepted one is accumulated.
+double photometricEnergy(const BundleAdjuster::Impl& m, const Linearization& L);
+double cameraTermsEnergy(BundleAdjuster::Impl& m, const BundleAdjustmentConfig& cfg,
+                         const std::vector<const WindowTerm*>& terms);
 double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
                       Eigen::Ref<Eigen::VectorXd> b);
 
@@ -397,11 +408,14 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       idepth_backup[i] = p.idepth;
       p.idepth = std::max(p.idepth + dx_p[static_cast<Eigen::Index>(i)], 1e-6);
     }
-    ba::linearizePhotometric(m, m.trial, config_, camera_, timing_);
-    ba::addCameraTerms(m, m.trial, config_, terms_);
+    // The trial's energy first; its blocks only when the step is accepted (a rejected step's
+    // accumulation would be thrown away). The energies are the same bits as the full linearisation's.
+    ba::evaluatePhotometric(m, m.trial, config_, camera_, timing_);
     ++s.iterations;
-    const double e_new = m.trial.total();
+    const double e_new = ba::photometricEnergy(m, m.trial) + ba::cameraTermsEnergy(m, config_, terms_);
     if (e_new < e) {
+      ba::accumulatePhotometric(m, m.trial, config_, false);
+      ba::addCameraTerms(m, m.trial, config_, terms_);
       std::swap(m.cur, m.trial);
       ++s.accepted;
       const double rel = (e - e_new) / std::max(e, 1e-300);
