@@ -43,6 +43,7 @@ struct PairWork {
   Eigen::Matrix3Xd bearing;
   Eigen::VectorXd v_h, idepth;
   std::vector<RsHostProjection> proj;
+  std::vector<RsHostPoint> host_pts;  // rolling shutter: the observations' Impl::host_points, gathered
 };
 
 struct ObsRef {
@@ -99,6 +100,9 @@ struct BundleAdjuster::Impl {
   // Linearisations: current (accepted) and trial.
   Linearization cur, trial;
   std::vector<ChunkSums> chunks;
+  // Rolling shutter: each point's target-independent host part (rsHostPoint), computed once per
+  // linearisation and shared by all the point's targets.
+  std::vector<RsHostPoint> host_points;
   Eigen::MatrixXd probe_H;              // scratch of ba::cameraTermsEnergy
   Eigen::VectorXd probe_b;
   const MarginalizationPrior* prior = nullptr;

@@ -158,10 +158,17 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   const bool rolling = cfg.layout.rolling;
   RsFrame host{pw.host->state.T_c_w, rolling ? pw.host->state.twist : Vec6::Zero()};
   RsFrame target{pw.target->state.T_c_w, rolling ? pw.target->state.twist : Vec6::Zero()};
-  if (rolling || kGeneralProjection)
+  if (rolling) {
+    pw.host_pts.resize(static_cast<size_t>(n));
+    for (int k = 0; k < n; ++k)
+      pw.host_pts[static_cast<size_t>(k)] =
+          m.host_points[static_cast<size_t>(m.obs_refs[static_cast<size_t>(pw.obs[static_cast<size_t>(k)])].point)];
+    projectRollingShutter(camera, timing, host, target, pw.bearing, pw.v_h, pw.idepth, pw.host_pts, pw.proj);
+  } else if (kGeneralProjection) {
     projectRollingShutter(camera, timing, host, target, pw.bearing, pw.v_h, pw.idepth, pw.proj);
-  else
+  } else {
     projectPairGlobal(camera, host, target, pw);
+  }
 
   const ImageLevel& img = pw.target->pyramid->level(0);
   const double exposure_ratio = (pw.host->exposure_ms > 0.0 && pw.target->exposure_ms > 0.0)
@@ -170,7 +177,6 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   const AffineTransfer tr = affineTransfer(pw.host->state.affine, pw.target->state.affine, exposure_ratio);
   const float alpha = static_cast<float>(tr.alpha), beta = static_cast<float>(tr.beta);
   const Eigen::Matrix3d R_w_h0 = pw.host->state.T_c_w.so3().inverse().matrix();
-  const TwistExp host_exp(host.xi);  // the host's row rotations exp(-omega_h t_h)
   const float e_out = kernel.outlier_energy;
 
   // Visit the observations in the order of their target rows (counting sort, stable): the pattern
@@ -200,7 +206,7 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
     if (!pr.valid) continue;
     // Local warp W = d p' / d p (host pixel -> target pixel at fixed inverse depth).
     Eigen::Matrix3d R_w_hp = R_w_h0;
-    if (rolling) R_w_hp = R_w_h0 * host_exp.rotation(-timing.rowTime(p.v));
+    if (rolling) R_w_hp = R_w_h0 * pw.host_pts[static_cast<size_t>(k)].E;  // exp(-omega_h t_h)
     const Eigen::Matrix2d Wm = pr.d_uv_d_X * R_w_hp * p.d_bearing_d_uv * (1.0 / p.idepth);
     const float warp[4] = {static_cast<float>(Wm(0, 0)), static_cast<float>(Wm(0, 1)), static_cast<float>(Wm(1, 0)),
                            static_cast<float>(Wm(1, 1))};
@@ -449,6 +455,25 @@ void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundle
   // The line delay being estimated is the globals' (the given timing's otherwise).
   m.timing = timing;
   if (m.gl >= 0 && m.globals) m.timing.line_delay_s = m.globals->state.line_delay_s;
+  if (cfg.layout.rolling) {
+    const KeyframeList& window = *m.window;
+    std::vector<TwistExp> ex;
+    ex.reserve(window.size());
+    for (const auto& kf : window) ex.emplace_back(kf->state.twist);
+    m.host_points.resize(m.points.size());
+    const int np = static_cast<int>(m.points.size());
+    m.runner->run(kPointChunks, [&](int chunk) {
+      const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
+      const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+      for (int i = begin; i < end; ++i) {
+        const ActivePoint& p = *m.points[static_cast<size_t>(i)];
+        if (!(p.idepth > 0.0) || !std::isfinite(p.idepth)) continue;  // projectRollingShutter skips it
+        const Keyframe& h = *p.host;
+        m.host_points[static_cast<size_t>(i)] = rsHostPoint(ex[static_cast<size_t>(h.index)], h.state.twist,
+                                                            m.timing.rowTime(p.v), p.bearing, p.idepth, true);
+      }
+    });
+  }
   m.runner->run(static_cast<int>(m.pairs.size()),
                 [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, m.timing, kernel); });
 }

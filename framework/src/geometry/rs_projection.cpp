@@ -148,10 +148,23 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
   solveWorldPoints(camera, timing, target, X_w, ptrs, options);
 }
 
-void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
-                           const RsFrame& target, const Eigen::Matrix3Xd& bearing_h, const Eigen::VectorXd& v_h,
-                           const Eigen::VectorXd& idepth, std::vector<RsHostProjection>& out,
-                           const RsProjectionOptions& options) {
+RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, const Vec3& bearing_h, double rho,
+                        bool jacobians) {
+  RsHostPoint h;
+  Vec3 p;
+  ex_h.at(-t_h, h.E, p);  // exp(xi_h (-t_h))
+  h.Z = h.E * Vec3(bearing_h / rho) + p;
+  if (jacobians && t_h != 0.0) h.dZ = dLeftActionTimesJl(h.Z, -xi_h * t_h);
+  return h;
+}
+
+namespace {
+
+// host_points: given (one per column), or null: computed here.
+void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
+                       const RsFrame& target, const Eigen::Matrix3Xd& bearing_h, const Eigen::VectorXd& v_h,
+                       const Eigen::VectorXd& idepth, const std::vector<RsHostPoint>* host_points,
+                       std::vector<RsHostProjection>& out, const RsProjectionOptions& options) {
   const Eigen::Index n = bearing_h.cols();
   // Every entry is reset below: the world-point fields by solveWorldPoints(), the host fields here
   // (one zero-fill per entry instead of two).
@@ -162,9 +175,10 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
 
   // X_w = T_h_w0^-1 exp(-xi_h t_h) (b / rho); points with rho <= 0 are left out (invalid).
   std::vector<Eigen::Index> idx;
-  std::vector<Vec3> Z(static_cast<size_t>(n));
   const TwistExp ex_h(host.xi);
-  std::vector<Mat3> Eh_inv(static_cast<size_t>(n));  // rotation of exp(-xi_h t_h)
+  std::vector<RsHostPoint> computed;
+  if (!host_points) computed.resize(static_cast<size_t>(n));
+  const std::vector<RsHostPoint>& hp = host_points ? *host_points : computed;
   Eigen::Matrix3Xd X(3, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const double rho = idepth[i];
@@ -177,10 +191,9 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
     o.d_uv_d_Th0.setZero();
     o.d_uv_d_xi_h.setZero();
     o.d_uv_d_idepth.setZero();
-    Vec3 p;
-    ex_h.at(-timing.rowTime(v_h[i]), Eh_inv[s], p);  // exp(xi_h (-t_h))
-    Z[s] = Eh_inv[s] * Vec3(bearing_h.col(i) / rho) + p;
-    X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * Z[s];
+    if (!host_points)
+      computed[s] = rsHostPoint(ex_h, host.xi, timing.rowTime(v_h[i]), bearing_h.col(i), rho, options.jacobians);
+    X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * hp[s].Z;
     idx.push_back(i);
   }
   X.conservativeResize(3, static_cast<Eigen::Index>(idx.size()));
@@ -195,18 +208,35 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
     if (!r.valid) continue;
     const double rho = idepth[i];
     const double t_h = timing.rowTime(v_h[i]);
+    const RsHostPoint& h = hp[s];
     const Eigen::Matrix<double, 2, 3> d_uv_d_Z = r.d_uv_d_X * R_w_h0;
     // Host pose T_h_w0 <- exp(d) T_h_w0:  X = T_h_w0^-1 exp(-d) Z.
-    r.d_uv_d_Th0 = -d_uv_d_Z * dLeftAction(Z[s]);
+    r.d_uv_d_Th0 = -d_uv_d_Z * dLeftAction(h.Z);
     // Host twist: Z = exp(-xi_h t_h) Y,  d Z / d xi_h = [I, -[Z]x] Jl(-xi_h t_h) (-t_h).
     if (t_h != 0.0)
-      r.d_uv_d_xi_h = d_uv_d_Z * dLeftActionTimesJl(Z[s], -host.xi * t_h) * (-t_h);
+      r.d_uv_d_xi_h = d_uv_d_Z * h.dZ * (-t_h);
     else
       r.d_uv_d_xi_h.setZero();
-    r.d_uv_d_idepth = d_uv_d_Z * (Eh_inv[s] * Vec3(-bearing_h.col(i) / (rho * rho)));
+    r.d_uv_d_idepth = d_uv_d_Z * (h.E * Vec3(-bearing_h.col(i) / (rho * rho)));
     // Host row time: d Z / d t_h = -(xi_v + xi_w x Z).
-    r.d_uv_d_line_delay += d_uv_d_Z * Vec3(-(xh_v + xh_w.cross(Z[s]))) * timing.dRowTimeDLineDelay(v_h[i]);
+    r.d_uv_d_line_delay += d_uv_d_Z * Vec3(-(xh_v + xh_w.cross(h.Z))) * timing.dRowTimeDLineDelay(v_h[i]);
   }
+}
+
+}  // namespace
+
+void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
+                           const RsFrame& target, const Eigen::Matrix3Xd& bearing_h, const Eigen::VectorXd& v_h,
+                           const Eigen::VectorXd& idepth, std::vector<RsHostProjection>& out,
+                           const RsProjectionOptions& options) {
+  projectHostPoints(camera, timing, host, target, bearing_h, v_h, idepth, nullptr, out, options);
+}
+
+void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
+                           const RsFrame& target, const Eigen::Matrix3Xd& bearing_h, const Eigen::VectorXd& v_h,
+                           const Eigen::VectorXd& idepth, const std::vector<RsHostPoint>& host_points,
+                           std::vector<RsHostProjection>& out, const RsProjectionOptions& options) {
+  projectHostPoints(camera, timing, host, target, bearing_h, v_h, idepth, &host_points, out, options);
 }
 
 RsProjection projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& target,

@@ -156,6 +156,28 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
                            const Eigen::VectorXd& v_h, const Eigen::VectorXd& idepth,
                            std::vector<RsHostProjection>& out, const RsProjectionOptions& options = {});
 
+// The part of a host point's projection that does not depend on the target: the rotation E of
+// exp(-xi_h t_h) at its row time t_h = t(v_h), the point Z = exp(-xi_h t_h) (b / rho) in the host's
+// central frame, and dZ = [I, -[Z]x] Jl(-xi_h t_h) (d Z / d xi_h before its factor -t_h; zero for
+// t_h = 0 or without Jacobians). rsHostPoint() is the one place these are computed, so a projection
+// from cached host points (the bundle adjustment computes them once per point and linearisation and
+// reuses them for every target) is bit-identical to the one that computes them.
+struct RsHostPoint {
+  Mat3 E = Mat3::Identity();
+  Vec3 Z = Vec3::Zero();
+  Eigen::Matrix<double, 3, 6> dZ = Eigen::Matrix<double, 3, 6>::Zero();
+};
+// ex_h = TwistExp(xi_h); rho > 0 and finite (the caller skips the others).
+RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, const Vec3& bearing_h, double rho,
+                        bool jacobians);
+// As above, with the host points given (host_points[i] = rsHostPoint(...) of column i for every column
+// with a valid inverse depth; the others are not read).
+void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,
+                           const RsFrame& target, const Eigen::Matrix3Xd& bearing_h,
+                           const Eigen::VectorXd& v_h, const Eigen::VectorXd& idepth,
+                           const std::vector<RsHostPoint>& host_points, std::vector<RsHostProjection>& out,
+                           const RsProjectionOptions& options = {});
+
 // Single-point versions (not for hot loops).
 RsProjection projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& target,
                                    const Vec3& X_w, const RsProjectionOptions& options = {});
