@@ -139,6 +139,45 @@ TEST_F(RsHostProjectionTest, BatchEqualsSinglePoints) {
   EXPECT_GT(n_valid, n / 2);
 }
 
+TEST_F(RsHostProjectionTest, GivenHostPointsGiveTheSameBitsAsComputedOnes) {
+  // The bundle adjustment computes each point's host part once (rsHostPoint) and projects it into every
+  // target with the overload that takes it; that must be the projection that computes it itself.
+  const int n = 30;
+  Eigen::Matrix3Xd B(3, n);
+  Eigen::VectorXd v_h(n), rho(n);
+  std::vector<RsHostPoint> hp(static_cast<size_t>(n));
+  const TwistExp ex(host_.xi);
+  for (int i = 0; i < n; ++i) {
+    const Vec2 px(10.0 * i + 4.0, 8.0 * i + 2.0);
+    Vec3 b;
+    ASSERT_TRUE(cam_->unproject(px, b));
+    B.col(i) = b;
+    v_h[i] = px.y();
+    rho[i] = (i % 9 == 4) ? 0.0 : 0.2 + 0.03 * i;
+    if (rho[i] > 0) hp[static_cast<size_t>(i)] = rsHostPoint(ex, host_.xi, timing_.rowTime(v_h[i]), b, rho[i], true);
+  }
+  std::vector<RsHostProjection> computed, given;
+  projectRollingShutter(*cam_, timing_, host_, target_, B, v_h, rho, computed);
+  projectRollingShutter(*cam_, timing_, host_, target_, B, v_h, rho, hp, given);
+  int n_valid = 0;
+  for (int i = 0; i < n; ++i) {
+    ASSERT_EQ(given[i].valid, computed[i].valid) << i;
+    if (!computed[i].valid) continue;
+    ++n_valid;
+    EXPECT_EQ(given[i].uv, computed[i].uv) << i;
+    EXPECT_EQ(given[i].d_uv_d_Th0, computed[i].d_uv_d_Th0) << i;
+    EXPECT_EQ(given[i].d_uv_d_xi_h, computed[i].d_uv_d_xi_h) << i;
+    EXPECT_EQ(given[i].d_uv_d_idepth, computed[i].d_uv_d_idepth) << i;
+    EXPECT_EQ(given[i].d_uv_d_line_delay, computed[i].d_uv_d_line_delay) << i;
+    EXPECT_EQ(given[i].d_uv_d_xi, computed[i].d_uv_d_xi) << i;
+  }
+  EXPECT_GT(n_valid, n / 2);
+  // A host part of another host twist is not the same projection (the given one is what is used).
+  hp[1] = rsHostPoint(TwistExp(Vec6::Zero()), Vec6::Zero(), timing_.rowTime(v_h[1]), B.col(1), rho[1], true);
+  projectRollingShutter(*cam_, timing_, host_, target_, B, v_h, rho, hp, given);
+  EXPECT_GT((given[1].uv - computed[1].uv).norm(), 1e-3);
+}
+
 TEST_F(RsHostProjectionTest, RowTimingFromShutterPlugins) {
   CameraCalibration calib = cam_->calibration();
   calib.line_delay_s = 0.0;
