@@ -229,6 +229,9 @@ ParamTable TrackerOptions::paramTable() {
       paramDouble("track_min_explained_ratio", d.min_explained_ratio, 0.0, 1.0, "",
                   "lower share of the points in view whose residual RMS is below half their pattern's "
                   "intensity spread: tracking lost"),
+      paramInt("track_twist_retries", d.twist_retries, 0, 5, "",
+               "rolling shutter: a frame lost with its predicted twist is tracked again this many times at most, "
+               "with the twist's rotation re-estimated from the pose each attempt reached (0: never)"),
   };
 }
 
@@ -242,6 +245,7 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.min_inlier_ratio = p.getDouble("track_min_inlier_ratio");
   o.max_rmse = p.getDouble("track_max_rmse");
   o.min_explained_ratio = p.getDouble("track_min_explained_ratio");
+  o.twist_retries = static_cast<int>(p.getInt("track_twist_retries"));
   return o;
 }
 

@@ -7,11 +7,30 @@ namespace rsvio {
 
 Tracking::Tracking(const TrackerOptions& options, const CameraModel& camera, const RowTiming& timing,
                    std::vector<const MotionPrior*> motion)
-    : tracker_(std::make_unique<FrameTracker>(options, camera, timing)), motion_(std::move(motion)) {}
+    : tracker_(std::make_unique<FrameTracker>(options, camera, timing)),
+      motion_(std::move(motion)),
+      timing_(timing),
+      twist_retries_(options.twist_retries) {}
 
-TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok) {
-  TrackResult r = tracker_->track(pyr, info, guesses(info.t_ns));
-  *ok = r.ok() && r.T_c_w.translation().allFinite();
+TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_in, bool* ok) {
+  auto good = [](const TrackResult& r) { return r.ok() && r.T_c_w.translation().allFinite(); };
+  TrackingFrame info = info_in;
+  const std::vector<SE3d> g = guesses(info.t_ns);
+  TrackResult r = tracker_->track(pyr, info, g);
+  *ok = good(r);
+  // Twist retries (rolling shutter, see tracking.h): the lost attempt's pose, rotation-dominated, is
+  // mostly right where the predicted twist lagged a sudden change of the rotation rate (its readout
+  // shear is then missing from the model); the rate through that pose, extrapolated to the frame's
+  // time, is the better twist, and the pose the better first guess.
+  for (int k = 0; !*ok && timing_.dtDv() != 0.0 && k < twist_retries_; ++k) {
+    const SE3d T = r.T_c_w;
+    info.twist.tail<3>() = rotationRateAt(info.t_ns, &T);
+    std::vector<SE3d> gk{T};
+    gk.insert(gk.end(), g.begin(), g.end());
+    r = tracker_->track(pyr, info, gk);
+    *ok = good(r);
+    if (*ok) ++twist_rescues_;
+  }
   if (!*ok) {
     ++lost_in_row_;
     return r;
@@ -25,7 +44,10 @@ TrackResult Tracking::trackFrom(const ImagePyramid& pyr, const TrackingFrame& in
   return tracker_->track(pyr, info, guesses);
 }
 
-void Tracking::setTiming(const RowTiming& timing) { tracker_->setTiming(timing); }
+void Tracking::setTiming(const RowTiming& timing) {
+  tracker_->setTiming(timing);
+  timing_ = timing;
+}
 
 void Tracking::setReference(const TrackingReference& reference) {
   tracker_->setReference(reference);
@@ -54,6 +76,25 @@ Vec6 Tracking::frameTwistGuess(const Keyframe* newest) const {
   Vec6 xi = velocityEstimate();
   if (newest) xi.head<3>() = newest->state.twist.head<3>();
   return xi;
+}
+
+Vec3 Tracking::rotationRateAt(int64_t t_ns, const SE3d* last) const {
+  std::vector<std::pair<int64_t, const SE3d*>> h;
+  for (size_t i = history_.size() >= 3 ? history_.size() - 3 : 0; i < history_.size(); ++i)
+    h.emplace_back(history_[i].t_ns, &history_[i].T_c_w);
+  if (last) h.emplace_back(t_ns, last);
+  if (h.size() > 3) h.erase(h.begin());
+  if (h.size() < 2) return Vec3::Zero();
+  auto rate = [&](size_t i) {  // interval (i-1, i): mean rate and middle time (s)
+    const double dt = nsToS(h[i].first - h[i - 1].first);
+    return std::make_pair(Vec3((*h[i].second * h[i - 1].second->inverse()).so3().log() / dt),
+                          0.5 * nsToS(h[i].first + h[i - 1].first - 2 * h.front().first));
+  };
+  const auto [w1, c1] = rate(h.size() - 1);
+  if (h.size() < 3) return w1;
+  const auto [w0, c0] = rate(h.size() - 2);
+  const double tt = nsToS(t_ns - h.front().first);
+  return w1 + (w1 - w0) * ((tt - c1) / (c1 - c0));
 }
 
 void Tracking::pushHistory(int64_t t_ns, const SE3d& T_c_w, bool is_keyframe) {

@@ -6,8 +6,8 @@
 //   it, set by setReference());
 // - the motion history: the last 32 tracked frames (MotionState, oldest first), a keyframe's entry
 //   with its optimised pose;
-// - the frames lost in a row and the first tracking RMSE since the reference was set (the keyframe
-//   policy's RMSE cue).
+// - the frames lost in a row, the frames a twist retry saved, and the first tracking RMSE since the
+//   reference was set (the keyframe policy's RMSE cue).
 // It uses, not owns, the configured motion priors (motion.* plugins).
 //
 // Invariants
@@ -34,6 +34,10 @@ class Tracking {
            std::vector<const MotionPrior*> motion);
 
   // Tracks a frame from guesses(); *ok: tracked with a finite pose (else the lost counter grows).
+  // Rolling shutter: a frame lost with info.twist is tracked again, at most TrackerOptions::twist_retries
+  // times, from the pose the last attempt reached and with the twist's rotation rotationRateAt(t, that
+  // pose) (translation kept). A frame whose rotation rate changed suddenly is otherwise lost, as the
+  // fast preset's were within 2 s (docs/rolling_shutter.md, "Twist retries").
   TrackResult track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok);
   // Tracks a frame from given guesses; counters and history untouched (frames of the monocular start).
   TrackResult trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses);
@@ -42,6 +46,7 @@ class Tracking {
   void setTiming(const RowTiming& timing);
   void resetFirstRmse() { first_rmse_ = std::nan(""); }
   int lostInRow() const { return lost_in_row_; }
+  long twistRescues() const { return twist_rescues_; }  // frames tracked only by a twist retry
   double firstRmse() const { return first_rmse_; }
 
   // Motion history.
@@ -53,6 +58,11 @@ class Tracking {
   Vec6 velocityEstimate() const;  // per second, from the last two tracked frames (0 without)
   // Rolling shutter: a new frame's twist (see tracking.cpp); newest: the newest keyframe, or nullptr.
   Vec6 frameTwistGuess(const Keyframe* newest) const;
+  // Rotation rate (the twist's rotation part, per second) at time t_ns: the last two frame intervals'
+  // mean rates, each at its interval's middle, extrapolated linearly to t_ns; with `last` given, the
+  // newest interval is from the newest history entry to (t_ns, *last). Fewer than 2 intervals: the
+  // last interval's rate (0 without).
+  Vec3 rotationRateAt(int64_t t_ns, const SE3d* last = nullptr) const;
   // The first motion prior's fixed-mean twist prior for a new keyframe, if any has one.
   bool twistPrior(const MotionState& keyframe, TwistPrior* prior) const;
 
@@ -60,7 +70,10 @@ class Tracking {
   std::unique_ptr<FrameTracker> tracker_;
   std::vector<const MotionPrior*> motion_;
   std::vector<MotionState> history_;
+  RowTiming timing_;
+  int twist_retries_ = 0;
   int lost_in_row_ = 0;
+  long twist_rescues_ = 0;
   double first_rmse_ = std::nan("");
 };
 

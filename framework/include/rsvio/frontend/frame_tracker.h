@@ -85,6 +85,10 @@ struct TrackerOptions {
   bool estimate_a = true;
   bool estimate_b = true;
   int threads = 1;                                  // 1 or 2; results are identical
+  // Rolling shutter: a frame lost with its predicted twist is tracked again up to this many times, each
+  // time with the twist's rotation re-estimated from the pose the last attempt reached (Odometry's
+  // track(); the tracker itself holds the twist it is given).
+  int twist_retries = 2;
 
   static ParamTable paramTable();                   // keys track_* (see frontend_options.h)
   // Reads the track_* keys; `residual` is left for the caller (ResidualOptions::fromParams).
