@@ -94,7 +94,7 @@ TEST(Odometry, TinyRollingShutterLineDelayIsEstimatedOnline) {
 // Twist retries (tracking.h): on tiny_rs with rs_fast.json's motion (137 deg/s, 600 deg/s^2 mean), frames
 // whose rotation rate jumps are lost with the twist predicted from the last frame interval; tracked again
 // from the pose that attempt reached, with the rate through it, they track. Measured: with retries all 57
-// frames (1 rescued, frame 20), ATE 108 mm over 2.4 m of path; without them lost at frame 20. A retry
+// frames (1 frame rescued), ATE 108 mm over 2.4 m of path; without them lost at frame 20. A retry
 // that keeps the predicted twist (only the pose as the new guess) is lost at frame 20 too (shown once).
 TEST(Odometry, TinyFastRollingShutterFramesLostWithTheirPredictedTwistAreTrackedAfterATwistRetry) {
   const std::string data = simDataset(
