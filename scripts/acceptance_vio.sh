@@ -1,22 +1,28 @@
 #!/usr/bin/env bash
 # Acceptance figures of the rolling-shutter visual-inertial odometry (issues 13/14), outside CI:
-#   for each scene seed, simulate the medium-motion rolling-shutter sequence (configs/sim/demo.json:
-#   640x512, 20 Hz, 20 s, ~30 ms readout) and its global-shutter twin (same seed,
-#   --set effects.rolling_shutter=null), then run
+#   for each sequence and scene seed, simulate the rolling-shutter sequence and its global-shutter twin
+#   (same seed, --set effects.rolling_shutter=null), then run
 #     rs_vio on RS data with the true line delay given (58.94 us),
 #     gs_vio on RS data (the model that lacks the effect),
 #     gs_vio on the GS twin (the reference),
-#   and tabulate status, frames, keyframe ATE (SE(3): metric; Sim(3) and its scale), the time and scale
-#   of the visual-inertial initialisation and the final scale.
+#   and tabulate status, frames, keyframe ATE (SE(3): metric, the paper's eq. 35; Sim(3) and its
+#   scale), the time and scale of the visual-inertial initialisation and the final scale; with several
+#   sequences also one line per sequence (medians over the seeds) and the medians over all runs.
 #
 # Usage: bash scripts/acceptance_vio.sh [OUT_DIR] [SEED ...]   (default out/acceptance_vio, seeds 1 2 3)
 #   RSVIO_BIN  the binary (default build/bin/rsvio)
+#   SEQS       the sequences: "med" (default: configs/sim/demo.json, 640x512, 20 s of medium motion,
+#              ~30 ms readout, simulated with --seed SEED) and/or the paper's Table I sequences "01" .. "10"
+#              (configs/sim/seqNN.json, simulated with --seed 100*SEED+NN, so SEED 1 is the config's own,
+#              and only their first DURATION_S seconds: --set motion.duration_s=DURATION_S)
+#   DURATION_S the seconds simulated of the seqNN sequences (default 15, issue 14's acceptance)
 #   MODES      the runs per seed (default "rsvio_rs gsvio_rs gsvio_gs"); rsviodm_rs and gsviodm_gs are
 #              rs_vio on RS and gs_vio on the twin with imu.dynamic_marginalization=true
 #   SETS       more --set lines for every run, e.g. SETS="imu.init_scale_factor=1.3"
-#   TAG        appended to the run folders (run_s<seed>_<mode><TAG>), to keep variants apart
-# Datasets are simulated once into OUT_DIR/med_<rs|gs>_s<seed> and reused (about 3 min each on 2 cores);
-# each run takes 0.5-1 min; two runs go at a time.
+#   TAG        appended to the run folders (run_<seq>_s<seed>_<mode><TAG>), to keep variants apart
+# Datasets are simulated once into OUT_DIR/<seq>_<rs|gs>_s<seed> and reused (0.5-3 min each on 2
+# cores); each run takes 0.5-1 min; two runs go at a time.
+# All 10 sequences, 3 seeds: SEQS="01 02 03 04 05 06 07 08 09 10" bash scripts/acceptance_vio.sh out/vio_seqs
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-out/acceptance_vio}
@@ -28,39 +34,50 @@ MODES=${MODES:-rsvio_rs gsvio_rs gsvio_gs}
 [ -x "$BIN" ] || { echo "acceptance_vio: $BIN not found; run scripts/build.sh or set RSVIO_BIN" >&2; exit 2; }
 mkdir -p "$OUT"
 
-for seed in "${SEEDS[@]}"; do
-  for sh in rs gs; do
-    data="$OUT/med_${sh}_s$seed"
-    [ -f "$data/truth.json" ] && continue
-    echo "== simulating configs/sim/demo.json ($sh), seed $seed -> $data"
-    set_gs=()
-    [ "$sh" = gs ] && set_gs=(--set effects.rolling_shutter=null)
-    "$BIN" -q simulate --config configs/sim/demo.json --seed "$seed" --out "$data" "${set_gs[@]}"
+SEQS=${SEQS:-med}
+DURATION_S=${DURATION_S:-15}
+for seq in $SEQS; do
+  for seed in "${SEEDS[@]}"; do
+    for sh in rs gs; do
+      data="$OUT/${seq}_${sh}_s$seed"
+      [ -f "$data/truth.json" ] && continue
+      sim=(--config configs/sim/demo.json --seed "$seed")
+      if [ "$seq" != med ]; then
+        [ -f "configs/sim/seq$seq.json" ] || { echo "acceptance_vio: no configs/sim/seq$seq.json" >&2; exit 2; }
+        sim=(--config "configs/sim/seq$seq.json" --seed $((100 * seed + 10#$seq)) --set motion.duration_s="$DURATION_S")
+      fi
+      [ "$sh" = gs ] && sim+=(--set effects.rolling_shutter=null)
+      echo "== simulating ${sim[*]} -> $data"
+      "$BIN" -q simulate "${sim[@]}" --out "$data"
+    done
   done
 done
 
-run_one() {  # seed mode
-  local seed=$1 mode=$2 cfg data sets=()
+run_one() {  # seq seed mode
+  local seq=$1 seed=$2 mode=$3 cfg data sets=()
   case $mode in
-    rsvio_rs) cfg=configs/rs_vio.json; data="$OUT/med_rs_s$seed"; sets=(--set shutter.params.line_delay_us=58.94) ;;
-    gsvio_rs) cfg=configs/gs_vio.json; data="$OUT/med_rs_s$seed" ;;
-    gsvio_gs) cfg=configs/gs_vio.json; data="$OUT/med_gs_s$seed" ;;
-    rsviodm_rs) cfg=configs/rs_vio.json; data="$OUT/med_rs_s$seed"
+    rsvio_rs) cfg=configs/rs_vio.json; data="$OUT/${seq}_rs_s$seed"; sets=(--set shutter.params.line_delay_us=58.94) ;;
+    gsvio_rs) cfg=configs/gs_vio.json; data="$OUT/${seq}_rs_s$seed" ;;
+    gsvio_gs) cfg=configs/gs_vio.json; data="$OUT/${seq}_gs_s$seed" ;;
+    rsviodm_rs) cfg=configs/rs_vio.json; data="$OUT/${seq}_rs_s$seed"
                 sets=(--set shutter.params.line_delay_us=58.94 --set imu.dynamic_marginalization=true) ;;
-    gsviodm_gs) cfg=configs/gs_vio.json; data="$OUT/med_gs_s$seed"; sets=(--set imu.dynamic_marginalization=true) ;;
+    gsviodm_gs) cfg=configs/gs_vio.json; data="$OUT/${seq}_gs_s$seed"; sets=(--set imu.dynamic_marginalization=true) ;;
     *) echo "acceptance_vio: unknown mode $mode" >&2; return 1 ;;
   esac
   for s in ${SETS:-}; do sets+=(--set "$s"); done
-  local run="$OUT/run_s${seed}_$mode${TAG:-}"
+  local run="$OUT/run_${seq}_s${seed}_$mode${TAG:-}"
+  [ -f "$run/report.json" ] && [ -n "${REUSE_RUNS:-}" ] && return 0
   "$BIN" -q run --config "$cfg" --data "$data" --out "$run" --set output.render=false "${sets[@]}" > "$run.log" 2>&1 \
-    || echo "   (seed $seed $mode failed: see $run/report.json)"
+    || echo "   ($seq seed $seed $mode failed: see $run/report.json)"
   # The Sim(3) figures (report.json holds the SE(3) ones of metric outputs).
   "$BIN" -q eval --data "$data" --est "$run/keyframes.tum" --align sim3 --json > "$run.sim3.json" 2> /dev/null || true
 }
 
 jobs=()
-for seed in "${SEEDS[@]}"; do
-  for mode in $MODES; do jobs+=("$seed $mode"); done
+for seq in $SEQS; do
+  for seed in "${SEEDS[@]}"; do
+    for mode in $MODES; do jobs+=("$seq $seed $mode"); done
+  done
 done
 for ((i = 0; i < ${#jobs[@]}; i += 2)); do
   echo "== ${jobs[$i]}${jobs[$((i + 1))]:+, ${jobs[$((i + 1))]}}"
@@ -69,50 +86,77 @@ for ((i = 0; i < ${#jobs[@]}; i += 2)); do
   wait
 done
 
-python3 - "$OUT" "$MODES" "${TAG:-}" "${SEEDS[@]}" <<'EOF'
+python3 - "$OUT" "$MODES" "${TAG:-}" "$SEQS" "${SEEDS[@]}" <<'EOF'
 import json, sys, os, statistics
-out, modes, tag, seeds = sys.argv[1], sys.argv[2].split(), sys.argv[3], sys.argv[4:]
+out, modes, tag, seqs, seeds = sys.argv[1], sys.argv[2].split(), sys.argv[3], sys.argv[4].split(), sys.argv[5:]
 def load(p):
     try:
         return json.load(open(p))
     except Exception:
         return None
+def inf_median(v):
+    return statistics.median(v) if v else float("nan")
+def mm(v):
+    return "fail" if v == float("inf") else "%.1f" % (1e3 * v)
 print()
-print("%-4s %-10s %7s %7s %9s %10s %7s %8s %8s %7s %5s  %s" % ("seed", "mode", "status", "frames", "SE3 (mm)",
-      "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "error"))
-med = {}
-for mode in modes:
-    vals = []
-    for seed in seeds:
-        base = os.path.join(out, "run_s%s_%s%s" % (seed, mode, tag))
-        r = load(os.path.join(base, "report.json"))
-        if not r:
-            print("%-4s %-10s  (no report)" % (seed, mode)); vals.append(float("inf")); continue
-        s3 = load(base + ".sim3.json") or {}
-        ev = r.get("eval", {})
-        vio = r.get("extra", {}).get("vio", {})
-        metric = ev.get("align") == "se3"
-        se3 = ev.get("ate_rmse_m") if metric else None
-        sim3 = s3.get("ate_rmse_m")
-        scale = s3.get("alignment", {}).get("scale")
-        data = os.path.join(out, "med_%s_s%s" % (mode[-2:], seed))
-        t0 = (load(os.path.join(data, "truth.json")) or {}).get("clocks", {}).get("start_ns", 0) * 1e-9
-        ok = r["status"] == "ok"
-        vals.append(se3 if ok and se3 is not None else float("inf"))
-        init_t = vio.get("initialised_at_s")
-        dm = vio.get("dynamic_marginalization")
-        print("%-4s %-10s %7s %7d %9s %10s %7s %8s %8s %7s %5s  %s" % (
-            seed, mode, r["status"], r.get("frames", 0),
-            "%.1f" % (1e3 * se3) if se3 is not None else "-",
-            "%.1f" % (1e3 * sim3) if sim3 is not None else "-",
-            "%.3f" % scale if scale is not None else "-",
-            "%.2f" % (init_t - t0) if vio.get("initialised") and init_t else "-",
-            "%.3f" % vio["scale_at_initialisation"] if vio.get("initialised") else "-",
-            "%.3f" % vio["scale"] if vio.get("initialised") else "-",
-            "%d/%d" % (dm["switches"], dm["half_resets"]) if dm else "-",
-            (r.get("error") or "")[:80]))
-    med[mode] = statistics.median(vals) if vals else float("nan")
-print("medians of the SE(3) ATE (failed = inf): " + ", ".join("%s %.1f mm" % (m, 1e3 * v) for m, v in med.items()))
+print("%-4s %-4s %-10s %7s %7s %9s %10s %7s %8s %8s %7s %5s  %s" % ("seq", "seed", "mode", "status", "frames",
+      "SE3 (mm)", "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "error"))
+allv = {m: [] for m in modes}       # SE(3) ATE per run (failed = inf)
+perseq = {}                         # (seq, mode) -> median over the seeds
+scales = []                         # Sim(3) scales of successful rs_vio / gs_vio runs
+for seq in seqs:
+    for mode in modes:
+        vals = []
+        for seed in seeds:
+            base = os.path.join(out, "run_%s_s%s_%s%s" % (seq, seed, mode, tag))
+            r = load(os.path.join(base, "report.json"))
+            if not r:
+                print("%-4s %-4s %-10s  (no report)" % (seq, seed, mode)); vals.append(float("inf")); continue
+            s3 = load(base + ".sim3.json") or {}
+            ev = r.get("eval", {})
+            vio = r.get("extra", {}).get("vio", {})
+            metric = ev.get("align") == "se3"
+            se3 = ev.get("ate_rmse_m") if metric else None
+            sim3 = s3.get("ate_rmse_m")
+            scale = s3.get("alignment", {}).get("scale")
+            data = os.path.join(out, "%s_%s_s%s" % (seq, mode[-2:], seed))
+            t0 = (load(os.path.join(data, "truth.json")) or {}).get("clocks", {}).get("start_ns", 0) * 1e-9
+            ok = r["status"] == "ok"
+            vals.append(se3 if ok and se3 is not None else float("inf"))
+            if ok and scale is not None:
+                scales.append((seq, seed, mode, scale))
+            init_t = vio.get("initialised_at_s")
+            dm = vio.get("dynamic_marginalization")
+            print("%-4s %-4s %-10s %7s %7d %9s %10s %7s %8s %8s %7s %5s  %s" % (
+                seq, seed, mode, r["status"], r.get("frames", 0),
+                "%.1f" % (1e3 * se3) if se3 is not None else "-",
+                "%.1f" % (1e3 * sim3) if sim3 is not None else "-",
+                "%.3f" % scale if scale is not None else "-",
+                "%.2f" % (init_t - t0) if vio.get("initialised") and init_t else "-",
+                "%.3f" % vio["scale_at_initialisation"] if vio.get("initialised") else "-",
+                "%.3f" % vio["scale"] if vio.get("initialised") else "-",
+                "%d/%d" % (dm["switches"], dm["half_resets"]) if dm else "-",
+                (r.get("error") or "")[:80]))
+        allv[mode] += vals
+        perseq[(seq, mode)] = inf_median(vals)
+if len(seqs) > 1:
+    print()
+    print("median SE(3) ATE over the seeds, mm (fail: the median run failed)")
+    print("%-4s " % "seq" + " ".join("%10s" % m for m in modes) + ("   rs_vio RS / gs_vio GS" if
+          "rsvio_rs" in modes and "gsvio_gs" in modes else ""))
+    for seq in seqs:
+        line = "%-4s " % seq + " ".join("%10s" % mm(perseq[(seq, m)]) for m in modes)
+        if "rsvio_rs" in modes and "gsvio_gs" in modes:
+            a, b = perseq[(seq, "rsvio_rs")], perseq[(seq, "gsvio_gs")]
+            line += "   %s" % ("-" if a == float("inf") or b == float("inf") else "%.2fx" % (a / b))
+        print(line)
+med = {m: inf_median(v) for m, v in allv.items()}
+print("medians of the SE(3) ATE over all runs (failed = inf): " + ", ".join("%s %s mm" % (m, mm(v)) for m, v in med.items()))
+print("failed runs: " + ", ".join("%s %d/%d" % (m, sum(x == float("inf") for x in v), len(v)) for m, v in allv.items()))
 if "rsvio_rs" in med and "gsvio_gs" in med:
     print("rs_vio on RS vs gs_vio on the twin %.2fx" % (med["rsvio_rs"] / med["gsvio_gs"]))
+off = [x for x in scales if x[2] != "gsvio_rs" and abs(x[3] - 1.0) > 0.02]
+print("Sim(3) scale of successful rs_vio/gs_vio-on-twin runs: %d of %d within 2 %% of 1%s" % (
+    sum(1 for x in scales if x[2] != "gsvio_rs") - len(off), sum(1 for x in scales if x[2] != "gsvio_rs"),
+    "" if not off else "; outside: " + ", ".join("%s s%s %s %.3f" % x for x in off)))
 EOF

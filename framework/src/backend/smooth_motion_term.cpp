@@ -23,7 +23,7 @@ bool SmoothMotionTerm::evaluate(const Keyframe& k, Eval* e) const {
   e->d_r_d_Tb = -SE3d::leftJacobianInverse(u) / D;
   e->d_r_d_Ta = SE3d::rightJacobianInverse(u) / D;
   const double f = D > o_.gap_ref_s ? (o_.gap_ref_s / D) * (o_.gap_ref_s / D) : 1.0;
-  e->W = o_.information * f;
+  e->W = o_.information * (f * k.motion_weight);
   return true;
 }
 

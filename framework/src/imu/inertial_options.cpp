@@ -21,6 +21,13 @@ ParamTable inertialParamTable() {
       paramDouble("time_offset_correction_ms", d.time_offset_correction_ms, -1000.0, 1000.0, "ms",
                   "added to the calibration's camera-IMU time offset (t_imu = t_cam + offset): the value rsvio "
                   "diagnose measures when the calibration lacks it"),
+      paramBool("frame_twist_from_imu", d.frame_twist_from_imu,
+                "rolling shutter, after the initialisation: a new frame's twist (held by the tracker, used by the "
+                "candidate tracer) from the IMU (gyroscope at the frame's time, propagated velocity; paper eq. 32) "
+                "instead of from the tracked frames"),
+      paramDouble("smooth_motion_weight", d.smooth_motion_weight, 0.0, 1e6, "",
+                  "rolling shutter: weight of the smooth-motion twist prior of keyframes that have the IMU twist "
+                  "energy (after the initialisation); 1: the same as before it"),
       paramInt("init_min_keyframes", d.init_min_keyframes, 3, 1000, "",
                "keyframes before the visual-inertial initialisation is tried"),
       paramDouble("init_min_duration_s", d.init_min_duration_s, 0.0, 1e6, "s",
@@ -76,6 +83,8 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.twist_weight = p.getDouble("twist_weight");
   o.estimate_time_offset = p.getBool("estimate_time_offset");
   o.time_offset_correction_ms = p.getDouble("time_offset_correction_ms");
+  o.frame_twist_from_imu = p.getBool("frame_twist_from_imu");
+  o.smooth_motion_weight = p.getDouble("smooth_motion_weight");
   o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));
   o.init_min_duration_s = p.getDouble("init_min_duration_s");
   o.init_min_accel_excitation_m_s2 = p.getDouble("init_min_accel_excitation_m_s2");

@@ -1,5 +1,9 @@
 #include "rsvio/imu/twist_prior.h"
 
+#include "rsvio/core/time.h"
+#include "rsvio/imu/imu_factor.h"
+#include "rsvio/imu/preintegration.h"
+
 namespace rsvio {
 
 Vec6 imuTwistPrior(const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyro, const SE3d& T_cf_wf,
@@ -12,6 +16,20 @@ Vec6 imuTwistPrior(const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyr
   Vec6 prior;
   prior << xi_cam.head<3>() / T_wm_wf.scale(), xi_cam.tail<3>();  // eq. 32, t_d = 1 (per second)
   return prior;
+}
+
+bool imuFrameTwist(const ImuBuffer& buffer, const ImuNoise& noise, const ImuState& from, int64_t t_from_cam_ns,
+                   int64_t t_cam_ns, double time_offset_s, const SE3d& T_cf_wf, const RxSO3d& T_wm_wf,
+                   const SE3d& T_cm_i, Vec6* xi) {
+  const int64_t off = sToNs(time_offset_s);
+  if (t_cam_ns < t_from_cam_ns || !buffer.covers(t_from_cam_ns + off, t_cam_ns + off)) return false;
+  Vec3 v_wm = from.v_w;
+  if (t_cam_ns > t_from_cam_ns)
+    v_wm = predictState(from, ImuPreintegration::fromBuffer(buffer, t_from_cam_ns, t_cam_ns, noise, from.bias,
+                                                            time_offset_s))
+               .v_w;
+  *xi = imuTwistPrior(buffer.interpolate(t_cam_ns + off).gyro_rad_s, v_wm, from.bias.gyro, T_cf_wf, T_wm_wf, T_cm_i);
+  return true;
 }
 
 Vec6 twistResidual(const Vec6& twist, const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyro,

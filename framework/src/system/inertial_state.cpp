@@ -292,4 +292,10 @@ void InertialState::fillMotionState(const Keyframe& ref, MotionState* ms) const 
   ms->v_wm = predictState(si, pre).v_w;
 }
 
+bool InertialState::frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_c_w, Vec6* xi) const {
+  if (!initialised_ || !rolling_ || !o_.frame_twist_from_imu) return false;
+  return imuFrameTwist(buffer_, sensors_.imu, imuStateOf(visualInertialStateOf(ref), globals_.state.T_wm_wf, T_cm_i_),
+                       ref.t_ns, t_ns, globals_.state.time_offset_s, T_c_w, globals_.state.T_wm_wf, T_cm_i_, xi);
+}
+
 }  // namespace rsvio

@@ -173,6 +173,11 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   info.t_ns = frame.t_ns;
   info.exposure_ms = frame.exposure_ms;
   info.twist = rolling ? tracking->frameTwistGuess(&ref) : Vec6::Zero();
+  const bool imu_twist = rolling && inertial && inertial->options().frame_twist_from_imu;
+  if (imu_twist) {  // the IMU's twist once initialised (InertialOptions::frame_twist_from_imu)
+    const std::vector<SE3d> g = tracking->guesses(frame.t_ns);
+    inertial->frameTwist(ref, frame.t_ns, g.empty() ? ref.state.T_c_w : g.front(), &info.twist);
+  }
   info.affine_guess = record->frames().empty() ? ref.state.affine : record->frames().back().affine;
   TrackResult r;
   bool ok = false;
@@ -199,6 +204,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
     ScopedStage st(record->stages(), "trace");
     CandidateFrame target;
     target.pose = RsFrame{r.T_c_w, rolling ? tracking->velocityEstimate() : Vec6::Zero()};
+    if (imu_twist) inertial->frameTwist(ref, frame.t_ns, r.T_c_w, &target.pose.xi);
     target.affine = r.affine;
     target.exposure_ms = frame.exposure_ms;
     window->traceCandidates(target, pyr->level(0));
@@ -253,6 +259,7 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
   if (inertial && !window->empty()) {
     const std::string w = inertial->onNewKeyframe(*kf, &window->newest());
     if (!w.empty()) record->addWarning(w);
+    if (kf->twist_energy) kf->motion_weight = inertial->options().smooth_motion_weight;
   }
   Keyframe& nk = window->insert(std::move(kf));
   {

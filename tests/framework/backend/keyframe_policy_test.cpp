@@ -12,6 +12,7 @@
 #include "rsvio/backend/backend_options.h"
 #include "rsvio/backend/keyframe_policy.h"
 #include "rsvio/core/error.h"
+#include "support/param_table_check.h"
 
 namespace rsvio {
 namespace {
@@ -294,25 +295,7 @@ TEST(BackendOptions, DefaultsAreDsos) {
 TEST(BackendOptions, EveryTableKeyIsRead) {
   const ParamTable table = backendParamTable();
   ASSERT_GE(table.size(), 30u);
-  nlohmann::json sec = nlohmann::json::object();
-  for (const ParamSpec& s : table) {
-    switch (s.type) {
-      case ParamSpec::Type::Bool: sec[s.key] = !s.default_value.get<bool>(); break;
-      case ParamSpec::Type::Int: {
-        const long d = s.default_value.get<long>();
-        sec[s.key] = d + 1 <= s.max ? d + 1 : d - 1;
-        break;
-      }
-      case ParamSpec::Type::Double: {
-        const double d = s.default_value.get<double>();
-        double v = d == 0.0 ? 0.5 * std::min(1.0, s.max) : d * 1.25;
-        if (v > s.max) v = d * 0.8;
-        sec[s.key] = v;
-        break;
-      }
-      default: FAIL() << s.key << ": unexpected type";
-    }
-  }
+  nlohmann::json sec = test::nonDefaultSection(table);
   // Keep the cross-field constraints satisfied.
   sec["min_keyframes"] = 6;
   sec["max_keyframes"] = 8;
@@ -356,14 +339,7 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["fail_min_inlier_ratio"] = o.fail_min_inlier_ratio;
   got["fail_min_points"] = o.fail_min_points;
   got["fail_max_scale_change"] = o.fail_max_scale_change;
-  for (const ParamSpec& s : table) {
-    ASSERT_TRUE(got.contains(s.key)) << "backend." << s.key << " is in the table but not checked by this test";
-    if (s.type == ParamSpec::Type::Double)
-      EXPECT_DOUBLE_EQ(got[s.key].get<double>(), sec[s.key].get<double>()) << "backend." << s.key;
-    else
-      EXPECT_EQ(got[s.key], sec[s.key]) << "backend." << s.key;
-  }
-  EXPECT_EQ(got.size(), table.size()) << "a BackendOptions field checked here is missing from the table";
+  test::expectEveryKeyRead("backend", table, sec, got);
 }
 
 TEST(BackendOptions, ProblemsNameTheKey) {

@@ -11,8 +11,9 @@
 //   window.h. With both neighbours it is the central difference of the optimised neighbour poses;
 //   a keyframe that is the newest (no next yet) gets the backward difference, the first keyframe of a
 //   run the forward one.
-// - Energy r^T W r, W = information * min(1, (gap_ref_s / (t_b - t_a))^2): the constant-twist
-//   assumption degrades with the time the difference spans.
+// - Energy r^T W r, W = information * min(1, (gap_ref_s / (t_b - t_a))^2) * Keyframe::motion_weight:
+//   the constant-twist assumption degrades with the time the difference spans; a keyframe whose twist
+//   the IMU measures (twist energy) may weigh it less (InertialOptions::smooth_motion_weight).
 // - Jacobians (LEFT pose perturbations T <- exp(d) T, rsvio/lie/lie.h; twists additive), with
 //   u = log(T_b T_a^-1), D = t_b - t_a:
 //     d r / d xi_k = I,   d r / d T_b = -Jl^-1(u) / D,   d r / d T_a = +Jr^-1(u) / D

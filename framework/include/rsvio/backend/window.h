@@ -145,6 +145,7 @@ struct Keyframe {
   // Smooth-motion term inside the optimisation (backend/smooth_motion_term.h): the keyframe's motion
   // neighbours (nullptr: none) and whether its term is still active (false once marginalised).
   bool motion_term = false;
+  double motion_weight = 1.0;  // multiplies the term's information (set when the keyframe is made)
   Keyframe* motion_prev = nullptr;
   Keyframe* motion_next = nullptr;
   // Visual-inertial terms (backend/inertial_term.h): the IMU factor from imu_prev to this keyframe,

@@ -21,6 +21,16 @@ struct InertialOptions {
   // Added to the calibration's time offset (what rsvio diagnose measures when the calibration lacks
   // it); with estimate_time_offset the estimate starts there.
   double time_offset_correction_ms = 0.0;
+  // Rolling shutter, after the initialisation: a new frame's twist, which the frame tracker holds and
+  // the candidate tracer uses, is the IMU's (eq. 32 at the frame's time: the gyroscope there less the
+  // gyro bias, the velocity propagated from the newest keyframe) instead of the tracked frames' rate,
+  // which lags a changing rotation by half a frame interval. Off: on the medium sequences it gained
+  // nothing (docs/vio.md, "The IMU's twist in the tracker and a lighter smooth-motion prior").
+  bool frame_twist_from_imu = false;
+  // Rolling shutter: the weight of the smooth-motion twist prior (backend/smooth_motion_term.h) of a
+  // keyframe that has the IMU twist energy (made after the initialisation); 1: as before it. Lighter
+  // weights lost track or were less accurate there (same section).
+  double smooth_motion_weight = 1.0;
   // Visual-inertial initialisation (vi_init.h), tried at every new keyframe until it succeeds.
   int init_min_keyframes = 8;
   double init_min_duration_s = 1.5;

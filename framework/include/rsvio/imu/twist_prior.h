@@ -17,6 +17,7 @@
 #pragma once
 #include <Eigen/Core>
 
+#include "rsvio/imu/imu_buffer.h"
 #include "rsvio/imu/imu_types.h"
 #include "rsvio/lie/rxso3.h"
 #include "rsvio/lie/se3.h"
@@ -34,6 +35,17 @@ struct TwistPriorJacobians {
 // Eq. 32: the IMU's prediction of the keyframe's camera twist in W_f units per second.
 Vec6 imuTwistPrior(const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyro, const SE3d& T_cf_wf,
                    const RxSO3d& T_wm_wf, const SE3d& T_cm_i);
+
+// The IMU's twist of a later frame (camera time t_cam_ns >= t_from_cam_ns): eq. 32 at that time, from
+// a keyframe's metric IMU state `from` at t_from_cam_ns (biases from.bias): the gyroscope interpolated
+// at t_cam_ns + time_offset_s less from.bias.gyro, from.v_w propagated to t_cam_ns with the
+// preintegrated IMU (eq. 15), the rotation of the frame's T_cf_wf (its pose or a guess of it). What
+// the frame tracker holds and the candidate tracer uses for a rolling-shutter frame of a
+// visual-inertial run (system/inertial_state.h). False (xi untouched) when `buffer` does not cover
+// [t_from, t] on the IMU clock.
+bool imuFrameTwist(const ImuBuffer& buffer, const ImuNoise& noise, const ImuState& from, int64_t t_from_cam_ns,
+                   int64_t t_cam_ns, double time_offset_s, const SE3d& T_cf_wf, const RxSO3d& T_wm_wf,
+                   const SE3d& T_cm_i, Vec6* xi);
 
 // Eq. 33's residual r = prior - twist, with Jacobians (J may be null).
 Vec6 twistResidual(const Vec6& twist, const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyro,
