@@ -25,6 +25,9 @@ ParamTable inertialParamTable() {
                 "rolling shutter, after the initialisation: a new frame's twist (held by the tracker, used by the "
                 "candidate tracer) from the IMU (gyroscope at the frame's time, propagated velocity; paper eq. 32) "
                 "instead of from the tracked frames"),
+      paramBool("frame_rotation_from_gyro_before_init", d.frame_rotation_from_gyro_before_init,
+                "with frame_twist_from_imu, before the initialisation: the frame twist's rotation from the gyroscope "
+                "at the frame's time (gyro bias 0), its translation from the tracked frames"),
       paramDouble("smooth_motion_weight", d.smooth_motion_weight, 0.0, 1e6, "",
                   "rolling shutter: weight of the smooth-motion twist prior of keyframes that have the IMU twist "
                   "energy (after the initialisation); 1: the same as before it"),
@@ -85,6 +88,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.time_offset_correction_ms = p.getDouble("time_offset_correction_ms");
   o.frame_twist_from_imu = p.getBool("frame_twist_from_imu");
   o.smooth_motion_weight = p.getDouble("smooth_motion_weight");
+  o.frame_rotation_from_gyro_before_init = p.getBool("frame_rotation_from_gyro_before_init");
   o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));
   o.init_min_duration_s = p.getDouble("init_min_duration_s");
   o.init_min_accel_excitation_m_s2 = p.getDouble("init_min_accel_excitation_m_s2");

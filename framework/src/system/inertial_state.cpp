@@ -293,7 +293,13 @@ void InertialState::fillMotionState(const Keyframe& ref, MotionState* ms) const 
 }
 
 bool InertialState::frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_c_w, Vec6* xi) const {
-  if (!initialised_ || !rolling_ || !o_.frame_twist_from_imu) return false;
+  if (!rolling_ || !o_.frame_twist_from_imu) return false;
+  if (!initialised_) {  // no scale, velocity or bias yet: eq. 25's rotation from the gyroscope alone
+    const int64_t t = t_ns + offsetNs();
+    if (!o_.frame_rotation_from_gyro_before_init || !buffer_.covers(t, t)) return false;
+    xi->tail<3>() = -(T_cm_i_.so3() * (buffer_.interpolate(t).gyro_rad_s - ref.state.bias_gyro));
+    return true;
+  }
   return imuFrameTwist(buffer_, sensors_.imu, imuStateOf(visualInertialStateOf(ref), globals_.state.T_wm_wf, T_cm_i_),
                        ref.t_ns, t_ns, globals_.state.time_offset_s, T_c_w, globals_.state.T_wm_wf, T_cm_i_, xi);
 }

@@ -71,8 +71,9 @@ class InertialState {
   // Rolling shutter with options().frame_twist_from_imu, after the initialisation: the IMU's twist of a
   // frame at camera time t_ns >= ref.t_ns (eq. 32, per second, left of T_Cf_Wf): the gyroscope
   // interpolated at t_ns + offset less ref's gyro bias, ref's velocity propagated to t_ns, the rotation
-  // of T_c_w (the frame's pose or a guess of it). False (xi untouched) otherwise or without IMU data
-  // over [ref.t_ns, t_ns] on the IMU clock.
+  // of T_c_w (the frame's pose or a guess of it). Before it, with
+  // options().frame_rotation_from_gyro_before_init: only xi's rotation, -R_Cm_I (gyro - b_g). False
+  // (xi untouched) otherwise or without IMU data over [ref.t_ns, t_ns] on the IMU clock.
   bool frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_c_w, Vec6* xi) const;
 
   const WindowTerm* term() const { return initialised_ ? term_.get() : nullptr; }

@@ -24,6 +24,7 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["time_offset_correction_ms"] = o.time_offset_correction_ms;
   got["frame_twist_from_imu"] = o.frame_twist_from_imu;
   got["smooth_motion_weight"] = o.smooth_motion_weight;
+  got["frame_rotation_from_gyro_before_init"] = o.frame_rotation_from_gyro_before_init;
   got["init_min_keyframes"] = o.init_min_keyframes;
   got["init_min_duration_s"] = o.init_min_duration_s;
   got["init_min_accel_excitation_m_s2"] = o.init_min_accel_excitation_m_s2;

@@ -24,12 +24,16 @@ struct InertialOptions {
   // Rolling shutter, after the initialisation: a new frame's twist, which the frame tracker holds and
   // the candidate tracer uses, is the IMU's (eq. 32 at the frame's time: the gyroscope there less the
   // gyro bias, the velocity propagated from the newest keyframe) instead of the tracked frames' rate,
-  // which lags a changing rotation by half a frame interval. Off: on the medium sequences it gained
-  // nothing (docs/vio.md, "The IMU's twist in the tracker and a lighter smooth-motion prior").
-  bool frame_twist_from_imu = false;
+  // which lags a changing rotation by half a frame interval. On the paper's Table I motions it lowered
+  // rs_vio's median ATE from 58 to 36 mm (docs/vio.md, "The IMU's twist in the tracker").
+  bool frame_twist_from_imu = true;
+  // With frame_twist_from_imu, before the initialisation: the frame twist's rotation from the gyroscope
+  // at the frame's time (eq. 25's rotation, gyro bias 0), its translation as without the IMU. Off: it
+  // did not keep the early losses from happening (same section).
+  bool frame_rotation_from_gyro_before_init = false;
   // Rolling shutter: the weight of the smooth-motion twist prior (backend/smooth_motion_term.h) of a
   // keyframe that has the IMU twist energy (made after the initialisation); 1: as before it. Lighter
-  // weights lost track or were less accurate there (same section).
+  // weights lost track or were less accurate (docs/vio.md, same section).
   double smooth_motion_weight = 1.0;
   // Visual-inertial initialisation (vi_init.h), tried at every new keyframe until it succeeds.
   int init_min_keyframes = 8;
