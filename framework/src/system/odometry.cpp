@@ -173,7 +173,9 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   info.t_ns = frame.t_ns;
   info.exposure_ms = frame.exposure_ms;
   info.twist = rolling ? tracking->frameTwistGuess(&ref) : Vec6::Zero();
-  const bool imu_twist = rolling && inertial && inertial->options().frame_twist_from_imu;
+  // Only where InertialState::frameTwist has a twist to give: no motion-prior guesses made for nothing.
+  const bool imu_twist = rolling && inertial && inertial->options().frame_twist_from_imu &&
+                         (inertial->initialised() || inertial->options().frame_rotation_from_gyro_before_init);
   if (imu_twist) {  // the IMU's twist (InertialOptions::frame_twist_from_imu, InertialState::frameTwist)
     const std::vector<SE3d> g = tracking->guesses(frame.t_ns);
     inertial->frameTwist(ref, frame.t_ns, g.empty() ? ref.state.T_c_w : g.front(), &info.twist);
