@@ -43,10 +43,6 @@ void InertialState::addImu(const ImuSample& s) {
   buffer_.dropBefore(s.t_ns - sToNs(kBufferS));
 }
 
-SE3d InertialState::bodyPose(const SE3d& T_cf_wf) const {
-  return imuPoseFromCamera(T_cf_wf, globals_.state.T_wm_wf, T_cm_i_);
-}
-
 std::shared_ptr<const ImuFactor> InertialState::makeFactor(const Keyframe& from, const Keyframe& to) const {
   const int64_t off = offsetNs();
   if (!(to.t_ns > from.t_ns) || !buffer_.covers(from.t_ns + off, to.t_ns + off)) return nullptr;

@@ -84,8 +84,6 @@ class InertialState {
   double timeOffset() const { return globals_.state.time_offset_s; }
   double initialScale() const { return scale_init_; }
   const SE3d& T_cm_i() const { return T_cm_i_; }
-  // The metric body pose T_Wm_B of a camera pose T_Cf_Wf with the current T_Wm_Wf.
-  SE3d bodyPose(const SE3d& T_cf_wf) const;
 
  private:
   std::shared_ptr<const ImuFactor> makeFactor(const Keyframe& from, const Keyframe& to) const;

@@ -11,6 +11,7 @@
 #include "rsvio/config/validate.h"
 #include "rsvio/core/error.h"
 #include "rsvio/core/time.h"
+#include "rsvio/imu/imu_frames.h"
 #include "rsvio/imu/inertial_options.h"
 #include "rsvio/plugin/host.h"
 
@@ -138,19 +139,16 @@ void Odometry::Impl::fillInertial(int64_t t_ns) {
   if (MotionState* ms = tracking->historyAt(t_ns)) inertial->fillMotionState(window->newest(), ms);
 }
 
-void Odometry::Impl::toMetric(MapPoint* p) const {
-  p->p_w = (inertial->globals().state.T_wm_wf * p->p_w.cast<double>()).cast<float>();
-}
-
-io::Trajectory Odometry::Impl::toBody(io::Trajectory t) const {
-  if (!inertial || !inertial->initialised()) return t;
+io::Trajectory Odometry::Impl::toBody(io::Trajectory t, const std::vector<RxSO3d>& T_wm_wf) const {
+  if (!inertial || !inertial->initialised() || T_wm_wf.size() != t.poses.size()) return t;
   t.frame = io::PoseFrame::kBody;
   // Stamps on the IMU clock: t_imu = t_cam + time offset (the final estimate when it is estimated).
   const int64_t offset_ns = sToNs(inertial->timeOffset());
-  for (io::StampedPose& p : t.poses) {
+  for (size_t i = 0; i < t.poses.size(); ++i) {
+    io::StampedPose& p = t.poses[i];
     p.t_ns += offset_ns;
     const SE3d T_c_w = SE3d(p.q_W_X, p.p_W_X).inverse();
-    const SE3d T_wm_b = inertial->bodyPose(T_c_w);
+    const SE3d T_wm_b = imuPoseFromCamera(T_c_w, T_wm_wf[i], inertial->T_cm_i());
     p.p_W_X = T_wm_b.translation();
     p.q_W_X = T_wm_b.unit_quaternion();
   }
@@ -544,27 +542,21 @@ nlohmann::json Odometry::shutterReport() const {
 std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }
 const DiagnosticsLog& Odometry::diagnostics() const { return impl_->record->diagnostics(); }
 void Odometry::takeDiagnostics(std::vector<ObservationRow>* rows) { impl_->record->takeObservations(rows); }
-// Visual-inertial: points go out in W_m, mapped with T_Wm_Wf as it is when they are taken (points taken
-// before the initialisation stay in W_f; docs/vio.md).
-void Odometry::takePoints(std::vector<MapPoint>* points) {
-  const size_t n0 = points->size();
-  impl_->record->takePoints(points);
-  if (usesImu())
-    for (size_t i = n0; i < points->size(); ++i) impl_->toMetric(&(*points)[i]);
-}
+// Visual-inertial: points go out in W_m, mapped with T_Wm_Wf as it was when they left the window
+// (points taken before the initialisation stay in W_f; run_record.h, docs/vio.md).
+void Odometry::takePoints(std::vector<MapPoint>* points) { impl_->record->takePoints(points); }
 
 io::Trajectory Odometry::frameTrajectory() const {
-  return impl_->toBody(impl_->record->frameTrajectory(impl_->window->keyframes()));
+  std::vector<RxSO3d> T;
+  io::Trajectory t = impl_->record->frameTrajectory(impl_->window->keyframes(), &T);
+  return impl_->toBody(std::move(t), T);
 }
 io::Trajectory Odometry::keyframeTrajectory() const {
-  return impl_->toBody(impl_->record->keyframeTrajectory(impl_->window->keyframes()));
+  std::vector<RxSO3d> T;
+  io::Trajectory t = impl_->record->keyframeTrajectory(impl_->window->keyframes(), &T);
+  return impl_->toBody(std::move(t), T);
 }
-std::vector<MapPoint> Odometry::points() const {
-  std::vector<MapPoint> out = impl_->record->points(impl_->window->keyframes());
-  if (usesImu())
-    for (MapPoint& p : out) impl_->toMetric(&p);
-  return out;
-}
+std::vector<MapPoint> Odometry::points() const { return impl_->record->points(impl_->window->keyframes()); }
 std::vector<StateRow> Odometry::states() const {
   return impl_->record->states(impl_->window->keyframes());
 }

@@ -81,8 +81,9 @@ struct Odometry::Impl {
   void syncLineDelay();
   void tryInertialInitialisation();
   void fillInertial(int64_t t_ns);   // the history entry of t_ns gets its inertial fields (VIO)
-  io::Trajectory toBody(io::Trajectory t) const;
-  void toMetric(MapPoint* p) const;               // W_f -> W_m (VIO, after the initialisation)  // camera poses in W_f -> body poses in W_m (VIO)
+  // Camera poses in W_f -> body poses in W_m (VIO, after the initialisation), pose i with T_wm_wf[i]
+  // (RunRecord's per-pose transforms).
+  io::Trajectory toBody(io::Trajectory t, const std::vector<RxSO3d>& T_wm_wf) const;
   void finish();
   void fail(const std::string& reason);
 };

@@ -47,12 +47,26 @@ void RunRecord::takeObservations(std::vector<ObservationRow>* rows) {
 }
 
 void RunRecord::takePoints(std::vector<MapPoint>* points) {
+  if (metric_) {
+    const RxSO3d T = transformOf(nullptr);
+    for (size_t i = 0; i < map_points_.size(); ++i)
+      if (!point_in_wm_[i]) map_points_[i].p_w = (T * map_points_[i].p_w.cast<double>()).cast<float>();
+  }
   if (points->empty()) {
     points->swap(map_points_);
   } else {
     points->insert(points->end(), map_points_.begin(), map_points_.end());
   }
   map_points_.clear();
+  point_in_wm_.clear();
+}
+
+RxSO3d RunRecord::transformOf(const KeyframeRecord* r) const {
+  if (r && r->scale > 0) return r->T_wm_wf;
+  const KeyframeRecord* first = nullptr;
+  for (const auto& [id, k] : keyframes_)
+    if (k.scale > 0 && (!first || k.t_ns < first->t_ns)) first = &k;
+  return first ? first->T_wm_wf : currentTransform();
 }
 
 void RunRecord::recordFinal(Keyframe& kf) {
@@ -68,6 +82,7 @@ void RunRecord::recordKeyframe(const Keyframe& kf) {
   r.state = kf.state;
   r.time_offset_s = timeOffset();
   r.scale = scaleNow();
+  if (r.scale > 0 && metric_) r.T_wm_wf = globals_->state.T_wm_wf;
   r.line_delay_s = rolling_ ? timing_.line_delay_s : 0.0;
   if (rolling_) diag_.line_delay_s = timing_.line_delay_s;  // the log's header: the latest estimate
   if (!rolling_ && kf.has_observed_twist) r.state.twist = kf.observed_twist;
@@ -145,43 +160,72 @@ void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation&
 void RunRecord::pointLeaves(const ActivePoint& p) {
   const Vec3 X = pointInWorld(p, timing_, rolling_);
   if (!X.allFinite()) return;
-  map_points_.push_back(MapPoint{X.cast<float>(), p.pattern.color[kPatternCentre]});
+  // Visual-inertial: mapped to W_m now, with T_Wm_Wf as its host keyframe's window left it.
+  const Vec3 P = metric_ ? Vec3(currentTransform() * X) : X;
+  map_points_.push_back(MapPoint{P.cast<float>(), p.pattern.color[kPatternCentre]});
+  point_in_wm_.push_back(metric_ ? 1 : 0);
 }
 
-io::Trajectory RunRecord::frameTrajectory(const KeyframeList& window) const {
-  io::Trajectory t;
-  t.frame = io::PoseFrame::kCamera;
+io::Trajectory RunRecord::frameTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf) const {
+  const bool map = T_wm_wf && metric_;
+  std::vector<std::pair<io::StampedPose, RxSO3d>> poses;
   for (const FrameRecord& f : frames_) {
     if (!f.tracked) continue;
     SE3d T = f.T_c_w;
+    const KeyframeRecord* ref = nullptr;
     const auto it = keyframes_.find(f.ref_kf_id);
-    if (it != keyframes_.end()) T = f.T_f_ref * it->second.state.T_c_w;
+    if (it != keyframes_.end()) {
+      ref = &it->second;
+      T = f.T_f_ref * ref->state.T_c_w;
+    }
+    bool in_window = false;
     // A keyframe still in the window: its current state.
     for (const auto& kf : window)
-      if (kf->kf_id == f.ref_kf_id) T = f.T_f_ref * kf->state.T_c_w;
-    t.poses.push_back(stamped(f.t_ns, T));
+      if (kf->kf_id == f.ref_kf_id) {
+        T = f.T_f_ref * kf->state.T_c_w;
+        in_window = true;
+      }
+    poses.emplace_back(stamped(f.t_ns, T), map ? (in_window ? currentTransform() : transformOf(ref)) : RxSO3d());
   }
-  std::stable_sort(t.poses.begin(), t.poses.end(),
-                   [](const io::StampedPose& a, const io::StampedPose& b) { return a.t_ns < b.t_ns; });
+  std::stable_sort(poses.begin(), poses.end(), [](const auto& a, const auto& b) { return a.first.t_ns < b.first.t_ns; });
+  io::Trajectory t;
+  t.frame = io::PoseFrame::kCamera;
+  if (T_wm_wf) T_wm_wf->clear();
+  for (const auto& [p, T] : poses) {
+    t.poses.push_back(p);
+    if (map) T_wm_wf->push_back(T);
+  }
   return t;
 }
 
-io::Trajectory RunRecord::keyframeTrajectory(const KeyframeList& window) const {
+io::Trajectory RunRecord::keyframeTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf) const {
+  const bool map = T_wm_wf && metric_;
+  std::map<int64_t, std::pair<SE3d, RxSO3d>> by_time;
+  for (const auto& [id, r] : keyframes_) by_time[r.t_ns] = {r.state.T_c_w, map ? transformOf(&r) : RxSO3d()};
+  for (const auto& kf : window) by_time[kf->t_ns] = {kf->state.T_c_w, map ? currentTransform() : RxSO3d()};
   io::Trajectory t;
   t.frame = io::PoseFrame::kCamera;
-  std::map<int64_t, SE3d> by_time;
-  for (const auto& [id, r] : keyframes_) by_time[r.t_ns] = r.state.T_c_w;
-  for (const auto& kf : window) by_time[kf->t_ns] = kf->state.T_c_w;
-  for (const auto& [ts, T] : by_time) t.poses.push_back(stamped(ts, T));
+  if (T_wm_wf) T_wm_wf->clear();
+  for (const auto& [ts, TT] : by_time) {
+    t.poses.push_back(stamped(ts, TT.first));
+    if (map) T_wm_wf->push_back(TT.second);
+  }
   return t;
 }
 
 std::vector<MapPoint> RunRecord::points(const KeyframeList& window) const {
   std::vector<MapPoint> out = map_points_;
+  if (metric_) {
+    const RxSO3d T = transformOf(nullptr);
+    for (size_t i = 0; i < out.size(); ++i)
+      if (!point_in_wm_[i]) out[i].p_w = (T * out[i].p_w.cast<double>()).cast<float>();
+  }
   for (const auto& kf : window)
     for (const ActivePoint& p : kf->points) {
       const Vec3 X = pointInWorld(p, timing_, rolling_);
-      if (X.allFinite()) out.push_back(MapPoint{X.cast<float>(), p.pattern.color[kPatternCentre]});
+      if (!X.allFinite()) continue;
+      const Vec3 P = metric_ ? Vec3(currentTransform() * X) : X;
+      out.push_back(MapPoint{P.cast<float>(), p.pattern.color[kPatternCentre]});
     }
   return out;
 }

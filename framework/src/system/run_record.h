@@ -32,6 +32,7 @@
 #include "rsvio/io/diagnostics_log.h"
 #include "rsvio/io/states.h"
 #include "rsvio/io/trajectory.h"
+#include "rsvio/lie/rxso3.h"
 #include "rsvio/system/odometry.h"
 #include "stage_times.h"
 
@@ -59,6 +60,7 @@ struct KeyframeRecord {
   double time_offset_s = 0.0;  // the camera-IMU time offset when the record was made (a global state)
   double line_delay_s = 0.0;   // the line delay then (rolling shutter; it may be estimated online)
   double scale = 0.0;          // the metric scale then (metres per W_f unit; 0 before the VI initialisation)
+  RxSO3d T_wm_wf;              // the scale-gravity transform then (meaningful when scale > 0)
 };
 
 class RunRecord : public WindowSink {
@@ -75,7 +77,8 @@ class RunRecord : public WindowSink {
   // The global states a keyframe's record also keeps (the time offset); without them, the
   // calibration's offset.
   void setGlobals(const GlobalStates* g) { globals_ = g; }
-  // The scale became metric (visual-inertial initialisation): records from now on carry it.
+  // The scale became metric (visual-inertial initialisation): records from now on carry it, and the
+  // outputs are mapped to W_m (see the outputs below).
   void setMetric() { metric_ = true; }
 
   // Keyframes: the current state of a keyframe (its twist: see the invariants).
@@ -97,12 +100,23 @@ class RunRecord : public WindowSink {
   const DiagnosticsLog& diagnostics() const { return diag_; }
   // Moves the observation rows out (appended to *rows); the log keeps its header fields and IMU rows.
   void takeObservations(std::vector<ObservationRow>* rows);
-  // Moves the map points that left the window out (appended to *points).
+  // Moves the map points that left the window out (appended to *points), as points() maps them
+  // (points that left before the initialisation and are taken before it stay in W_f).
   void takePoints(std::vector<MapPoint>* points);
 
   // Outputs, with the keyframes and points still in `window` at their current state.
-  io::Trajectory frameTrajectory(const KeyframeList& window) const;     // refined frame poses
-  io::Trajectory keyframeTrajectory(const KeyframeList& window) const;
+  // Trajectories are camera poses in W_f. With T_wm_wf given (visual-inertial, after the
+  // initialisation), it receives per pose the scale-gravity transform that maps it to W_m: the one its
+  // keyframe (a frame's: its reference keyframe's) was last recorded with, so a keyframe that left
+  // the window keeps the metric pose it had then (the non-metric map's scale drifts and T_Wm_Wf follows
+  // it; mapping old poses with the final T_Wm_Wf would carry today's scale back to them). Window
+  // keyframes take the current transform; records made before the initialisation that of the
+  // earliest keyframe that has one.
+  io::Trajectory frameTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf = nullptr) const;
+  io::Trajectory keyframeTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf = nullptr) const;
+  // Map points: in W_f for visual odometry; visual-inertial, in W_m with T_Wm_Wf as it was when the
+  // point left the window (window points: the current one; points that left before the
+  // initialisation: that of the earliest keyframe that has one).
   std::vector<MapPoint> points(const KeyframeList& window) const;
   std::vector<StateRow> states(const KeyframeList& window) const;
 
@@ -123,6 +137,11 @@ class RunRecord : public WindowSink {
   std::vector<FrameRecord> frames_;
   std::map<int64_t, KeyframeRecord> keyframes_;  // by kf_id, every keyframe of the run
   std::vector<MapPoint> map_points_;             // points that left the window (marginalised)
+  std::vector<char> point_in_wm_;                // per map point: already mapped to W_m when it left
+  // The transform a pose or point is mapped to W_m with: a record's own (scale > 0), else the first
+  // metric record's, else the current one.
+  RxSO3d transformOf(const KeyframeRecord* r) const;
+  RxSO3d currentTransform() const { return globals_->state.T_wm_wf; }
   DiagnosticsLog diag_;
   StageTimes stages_;
   std::vector<std::string> warnings_;
