@@ -130,7 +130,7 @@ void Odometry::Impl::tryInertialInitialisation() {
   if (kfs.size() > kMaxInitKeyframes) kfs.erase(kfs.begin(), kfs.end() - kMaxInitKeyframes);
   if (window->initializeInertial(kfs)) {
     vi_init_t_ns = window->newest().t_ns;
-    record->setMetric();
+    record->setMetric(window->newest().t_ns);
   }
 }
 

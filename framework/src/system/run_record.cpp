@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "rsvio/core/time.h"
 
@@ -47,26 +48,32 @@ void RunRecord::takeObservations(std::vector<ObservationRow>* rows) {
 }
 
 void RunRecord::takePoints(std::vector<MapPoint>* points) {
-  if (metric_) {
-    const RxSO3d T = transformOf(nullptr);
-    for (size_t i = 0; i < map_points_.size(); ++i)
-      if (!point_in_wm_[i]) map_points_[i].p_w = (T * map_points_[i].p_w.cast<double>()).cast<float>();
-  }
+  if (metric_) toMetric(&map_points_);
   if (points->empty()) {
     points->swap(map_points_);
   } else {
     points->insert(points->end(), map_points_.begin(), map_points_.end());
   }
   map_points_.clear();
-  point_in_wm_.clear();
+  point_host_.clear();
+}
+
+void RunRecord::toMetric(std::vector<MapPoint>* points) const {
+  for (size_t i = 0; i < points->size(); ++i) {
+    const auto it = keyframes_.find(point_host_[i]);
+    const RxSO3d T = transformOf(it != keyframes_.end() ? &it->second : nullptr);
+    (*points)[i].p_w = (T * (*points)[i].p_w.cast<double>()).cast<float>();
+  }
 }
 
 RxSO3d RunRecord::transformOf(const KeyframeRecord* r) const {
-  if (r && r->scale > 0) return r->T_wm_wf;
-  const KeyframeRecord* first = nullptr;
-  for (const auto& [id, k] : keyframes_)
-    if (k.scale > 0 && (!first || k.t_ns < first->t_ns)) first = &k;
-  return first ? first->T_wm_wf : currentTransform();
+  // The first record from r on (kf_id order is time order) made after the scale settled: r's own
+  // once it has; before, the first keyframe's at or after the settling time.
+  const RxSO3d now = currentTransform();
+  const int64_t t0 = std::max(r ? r->t_ns : std::numeric_limits<int64_t>::min(), settled_t_ns_);
+  for (auto it = keyframes_.lower_bound(r ? r->kf_id : 0); it != keyframes_.end(); ++it)
+    if (it->second.t_ns >= t0 && it->second.scale > 0) return RxSO3d(it->second.scale, now.so3());
+  return now;
 }
 
 void RunRecord::recordFinal(Keyframe& kf) {
@@ -82,7 +89,6 @@ void RunRecord::recordKeyframe(const Keyframe& kf) {
   r.state = kf.state;
   r.time_offset_s = timeOffset();
   r.scale = scaleNow();
-  if (r.scale > 0 && metric_) r.T_wm_wf = globals_->state.T_wm_wf;
   r.line_delay_s = rolling_ ? timing_.line_delay_s : 0.0;
   if (rolling_) diag_.line_delay_s = timing_.line_delay_s;  // the log's header: the latest estimate
   if (!rolling_ && kf.has_observed_twist) r.state.twist = kf.observed_twist;
@@ -160,10 +166,8 @@ void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation&
 void RunRecord::pointLeaves(const ActivePoint& p) {
   const Vec3 X = pointInWorld(p, timing_, rolling_);
   if (!X.allFinite()) return;
-  // Visual-inertial: mapped to W_m now, with T_Wm_Wf as its host keyframe's window left it.
-  const Vec3 P = metric_ ? Vec3(currentTransform() * X) : X;
-  map_points_.push_back(MapPoint{P.cast<float>(), p.pattern.color[kPatternCentre]});
-  point_in_wm_.push_back(metric_ ? 1 : 0);
+  map_points_.push_back(MapPoint{X.cast<float>(), p.pattern.color[kPatternCentre]});
+  point_host_.push_back(p.host ? p.host->kf_id : -1);
 }
 
 io::Trajectory RunRecord::frameTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf) const {
@@ -215,16 +219,12 @@ io::Trajectory RunRecord::keyframeTrajectory(const KeyframeList& window, std::ve
 
 std::vector<MapPoint> RunRecord::points(const KeyframeList& window) const {
   std::vector<MapPoint> out = map_points_;
-  if (metric_) {
-    const RxSO3d T = transformOf(nullptr);
-    for (size_t i = 0; i < out.size(); ++i)
-      if (!point_in_wm_[i]) out[i].p_w = (T * out[i].p_w.cast<double>()).cast<float>();
-  }
+  if (metric_) toMetric(&out);
   for (const auto& kf : window)
     for (const ActivePoint& p : kf->points) {
       const Vec3 X = pointInWorld(p, timing_, rolling_);
       if (!X.allFinite()) continue;
-      const Vec3 P = metric_ ? Vec3(currentTransform() * X) : X;
+      const Vec3 P = metric_ ? Vec3(currentTransform() * X) : X;  // a window point: the current scale
       out.push_back(MapPoint{P.cast<float>(), p.pattern.color[kPatternCentre]});
     }
   return out;

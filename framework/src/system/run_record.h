@@ -60,7 +60,6 @@ struct KeyframeRecord {
   double time_offset_s = 0.0;  // the camera-IMU time offset when the record was made (a global state)
   double line_delay_s = 0.0;   // the line delay then (rolling shutter; it may be estimated online)
   double scale = 0.0;          // the metric scale then (metres per W_f unit; 0 before the VI initialisation)
-  RxSO3d T_wm_wf;              // the scale-gravity transform then (meaningful when scale > 0)
 };
 
 class RunRecord : public WindowSink {
@@ -77,9 +76,15 @@ class RunRecord : public WindowSink {
   // The global states a keyframe's record also keeps (the time offset); without them, the
   // calibration's offset.
   void setGlobals(const GlobalStates* g) { globals_ = g; }
-  // The scale became metric (visual-inertial initialisation): records from now on carry it, and the
-  // outputs are mapped to W_m (see the outputs below).
-  void setMetric() { metric_ = true; }
+  // The scale became metric (visual-inertial initialisation at t_ns, the newest keyframe's time):
+  // records from now on carry it, and the outputs are mapped to W_m (see the outputs below).
+  void setMetric(int64_t t_ns) {
+    metric_ = true;
+    settled_t_ns_ = t_ns + static_cast<int64_t>(kScaleSettleS * 1e9);
+  }
+  // The scale of the first second after the initialisation is not used for the outputs: the window's
+  // IMU factors are still refining it (tiny sequences: 6 % within 0.3 s; docs/vio.md "Outputs").
+  static constexpr double kScaleSettleS = 1.0;
 
   // Keyframes: the current state of a keyframe (its twist: see the invariants).
   void recordKeyframe(const Keyframe& kf);
@@ -106,17 +111,19 @@ class RunRecord : public WindowSink {
 
   // Outputs, with the keyframes and points still in `window` at their current state.
   // Trajectories are camera poses in W_f. With T_wm_wf given (visual-inertial, after the
-  // initialisation), it receives per pose the scale-gravity transform that maps it to W_m: the one its
-  // keyframe (a frame's: its reference keyframe's) was last recorded with, so a keyframe that left
-  // the window keeps the metric pose it had then (the non-metric map's scale drifts and T_Wm_Wf follows
-  // it; mapping old poses with the final T_Wm_Wf would carry today's scale back to them). Window
-  // keyframes take the current transform; records made before the initialisation that of the
-  // earliest keyframe that has one.
+  // initialisation), it receives per pose the scale-gravity transform that maps it to W_m: the current
+  // gravity rotation with the scale its keyframe (a frame's: its reference keyframe's) was last recorded
+  // with, so a keyframe that left the window keeps the metric scale it had then (the non-metric map's
+  // scale drifts and the scale follows it; the final scale would carry today's back over the run).
+  // Window keyframes take the current scale. Keyframes that left before the scale settled
+  // (kScaleSettleS after the initialisation, and all those before it) take the scale of the first
+  // keyframe recorded after that (the current one when there is none). The rotation is the current
+  // one for all: it changes little, and per-record rotations would put steps into the trajectory's
+  // rotation rates (probe.time_offset reads them).
   io::Trajectory frameTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf = nullptr) const;
   io::Trajectory keyframeTrajectory(const KeyframeList& window, std::vector<RxSO3d>* T_wm_wf = nullptr) const;
-  // Map points: in W_f for visual odometry; visual-inertial, in W_m with T_Wm_Wf as it was when the
-  // point left the window (window points: the current one; points that left before the
-  // initialisation: that of the earliest keyframe that has one).
+  // Map points: in W_f for visual odometry; visual-inertial, in W_m with their host keyframe's
+  // transform as above (window points: the current one).
   std::vector<MapPoint> points(const KeyframeList& window) const;
   std::vector<StateRow> states(const KeyframeList& window) const;
 
@@ -137,10 +144,14 @@ class RunRecord : public WindowSink {
   std::vector<FrameRecord> frames_;
   std::map<int64_t, KeyframeRecord> keyframes_;  // by kf_id, every keyframe of the run
   std::vector<MapPoint> map_points_;             // points that left the window (marginalised)
-  std::vector<char> point_in_wm_;                // per map point: already mapped to W_m when it left
-  // The transform a pose or point is mapped to W_m with: a record's own (scale > 0), else the first
-  // metric record's, else the current one.
+  std::vector<int64_t> point_host_;              // per map point: its host keyframe's kf_id
+  int64_t settled_t_ns_ = 0;                     // the scale is used for the outputs from then on
+  // The transform a pose is mapped to W_m with (see the outputs): the current gravity rotation and
+  // the scale of r's record or of the first after it made once the scale settled (r null: the first
+  // such record of all), else the current transform.
   RxSO3d transformOf(const KeyframeRecord* r) const;
+  // Map points (W_f) -> W_m with their host keyframe's transform; points and point_host_ index alike.
+  void toMetric(std::vector<MapPoint>* points) const;
   RxSO3d currentTransform() const { return globals_->state.T_wm_wf; }
   DiagnosticsLog diag_;
   StageTimes stages_;
