@@ -69,6 +69,26 @@ bool imuFactorCols(const Keyframe& j, const GlobalStates& g, const SE3d& T_cm_i,
   return true;
 }
 
+// Before the initialisation: the rotation rows of j's IMU factor on the pose columns (the contract).
+bool gyroRotationCols(const Keyframe& j, const GlobalStates& g, const SE3d& T_cm_i, const InertialTermOptions& o,
+                      Vec3* r, Mat3* W, std::vector<Col>* cols) {
+  if (!(o.gyro_bias_sigma_before_init_rad_s > 0.0) || !j.imu_term || !j.imu_prev || !j.imu_factor) return false;
+  const Keyframe& i = *j.imu_prev;
+  VisualInertialJacobians J;
+  const Vec15 r15 = visualInertialResidual(*j.imu_factor, visualInertialStateOf(i), visualInertialStateOf(j),
+                                           g.state.T_wm_wf, T_cm_i, g.state.time_offset_s, cols ? &J : nullptr);
+  *r = r15.head<3>();
+  const ImuPreintegration& p = j.imu_factor->preintegration();
+  const double sb = o.gyro_bias_sigma_before_init_rad_s * p.dt();
+  const Mat3 cov = p.covariance().topLeftCorner<3, 3>() + sb * sb * Mat3::Identity();
+  *W = o.imu_weight * cov.inverse();
+  if (!cols) return true;
+  cols->clear();
+  cols->push_back({&i, kPhoto, StateLayout::kPose, J.d_res_d_T_cf_wf_i.topRows<3>()});
+  cols->push_back({&j, kPhoto, StateLayout::kPose, J.d_res_d_T_cf_wf_j.topRows<3>()});
+  return true;
+}
+
 // The twist energy of k: residual, weight and Jacobian blocks.
 bool twistCols(const Keyframe& k, const GlobalStates& g, const SE3d& T_cm_i, const InertialTermOptions& o,
                const StateLayout& layout, Vec6* r, Mat6* W, std::vector<Col>* cols) {
@@ -100,7 +120,7 @@ VisualInertialKeyframe visualInertialStateOf(const Keyframe& k) {
 
 double InertialTerm::linearize(const KeyframeList& window, const StateLayout& layout, Eigen::MatrixXd& H,
                                Eigen::VectorXd& b) const {
-  if (!layout.inertial || !g_) return 0.0;
+  if (!g_) return 0.0;
   const int n = static_cast<int>(window.size());
   const RowOf rowOf = [&](const Keyframe* kf, Part p) {
     if (p == kGlobal) return layout.globalOffset(n);
@@ -110,6 +130,12 @@ double InertialTerm::linearize(const KeyframeList& window, const StateLayout& la
   double e = 0.0;
   std::vector<Col> cols;
   for (const auto& kf : window) {
+    if (!layout.inertial) {
+      Vec3 r;
+      Mat3 W;
+      if (gyroRotationCols(*kf, *g_, T_cm_i_, o_, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, H, b);
+      continue;
+    }
     Vec15 r;
     Mat15 W;
     if (imuFactorCols(*kf, *g_, T_cm_i_, o_, layout, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, H, b);
@@ -125,11 +151,11 @@ double InertialTerm::linearizeInvolving(const Keyframe& kf, const KeyframeList& 
   kfs->clear();
   H->resize(0, 0);
   b->resize(0);
-  if (!layout.inertial || !g_) return 0.0;
+  if (!g_) return 0.0;
   // The terms: kf's factor and twist energy, and the factor of every keyframe whose imu_prev is kf.
   std::vector<const Keyframe*> factor_of, twist_of;
   if (kf.imu_term && kf.imu_prev && kf.imu_factor) factor_of.push_back(&kf);
-  if (layout.rolling && kf.twist_energy) twist_of.push_back(&kf);
+  if (layout.inertial && layout.rolling && kf.twist_energy) twist_of.push_back(&kf);
   for (const auto& w : window)
     if (w.get() != &kf && w->imu_term && w->imu_prev == &kf && w->imu_factor) factor_of.push_back(w.get());
   auto addKf = [&](const Keyframe* k) {
@@ -155,6 +181,12 @@ double InertialTerm::linearizeInvolving(const Keyframe& kf, const KeyframeList& 
   double e = 0.0;
   std::vector<Col> cols;
   for (const Keyframe* j : factor_of) {
+    if (!layout.inertial) {
+      Vec3 r;
+      Mat3 W;
+      if (gyroRotationCols(*j, *g_, T_cm_i_, o_, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, *H, *b);
+      continue;
+    }
     Vec15 r;
     Mat15 W;
     if (imuFactorCols(*j, *g_, T_cm_i_, o_, layout, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, *H, *b);

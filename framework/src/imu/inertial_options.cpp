@@ -31,6 +31,9 @@ ParamTable inertialParamTable() {
       paramDouble("smooth_motion_weight", d.smooth_motion_weight, 0.0, 1e6, "",
                   "rolling shutter: weight of the smooth-motion twist prior of keyframes that have the IMU twist "
                   "energy (after the initialisation); 1: the same as before it"),
+      paramDouble("gyro_bias_sigma_before_init_rad_s", d.gyro_bias_sigma_before_init_rad_s, 0.0, 10.0, "rad/s",
+                  "before the initialisation: the gyroscope's relative rotations between keyframes in the window, "
+                  "with this sigma for the gyro bias not estimated yet; 0: off"),
       paramInt("init_min_keyframes", d.init_min_keyframes, 3, 1000, "",
                "keyframes before the visual-inertial initialisation is tried"),
       paramDouble("init_min_duration_s", d.init_min_duration_s, 0.0, 1e6, "s",
@@ -88,6 +91,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.time_offset_correction_ms = p.getDouble("time_offset_correction_ms");
   o.frame_twist_from_imu = p.getBool("frame_twist_from_imu");
   o.smooth_motion_weight = p.getDouble("smooth_motion_weight");
+  o.gyro_bias_sigma_before_init_rad_s = p.getDouble("gyro_bias_sigma_before_init_rad_s");
   o.frame_rotation_from_gyro_before_init = p.getBool("frame_rotation_from_gyro_before_init");
   o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));
   o.init_min_duration_s = p.getDouble("init_min_duration_s");

@@ -31,6 +31,7 @@ InertialState::InertialState(const InertialOptions& o, const SensorSetup& sensor
   InertialTermOptions to;
   to.imu_weight = o.imu_weight;
   to.twist_weight = o.twist_weight;
+  to.gyro_bias_sigma_before_init_rad_s = o.gyro_bias_sigma_before_init_rad_s;
   if (twist_sigma_t_ > 0.0) to.twist_sigma_trans_m_s = twist_sigma_t_;
   if (twist_sigma_r_ > 0.0) to.twist_sigma_rot_rad_s = twist_sigma_r_;
   term_ = std::make_unique<InertialTerm>(to, T_cm_i_, &globals_);
@@ -66,7 +67,17 @@ std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
   kf.imu_term = false;
   kf.imu_prev = nullptr;
   kf.imu_factor.reset();
-  if (!initialised_ || !newest) return "";
+  if (!newest) return "";
+  if (!initialised_) {
+    // Before the initialisation, optionally: the factor for its rotation alone (inertial_term.h).
+    if (!gyroBeforeInit()) return "";
+    if (std::shared_ptr<const ImuFactor> f = makeFactor(*newest, kf)) {
+      kf.imu_prev = newest;
+      kf.imu_factor = f;
+      kf.imu_term = true;
+    }
+    return "";
+  }
   // Start at the prediction of the newest keyframe's state, then link the factor at that bias.
   kf.state.bias_gyro = newest->state.bias_gyro;
   kf.state.bias_accel = newest->state.bias_accel;
@@ -185,13 +196,24 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
 }
 
 void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& window, DynamicMarginalization& prior) const {
-  if (!initialised_) return;
+  if (!initialised_ && !gyroBeforeInit()) return;
   const StateLayout layout = prior.layout();
   std::vector<Keyframe*> kfs;
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
   term_->linearizeInvolving(leaving, window, layout, &kfs, &H, &b);
-  if (!kfs.empty()) {
+  if (!kfs.empty() && !initialised_) {
+    // The gyroscope's rotations: on the poses alone, independent of the scale.
+    const int d = layout.stateDim();
+    for (size_t i = 0; i < kfs.size(); ++i)
+      if (kfs[i]->gauge) {
+        const Eigen::Index o = static_cast<Eigen::Index>(i) * d;
+        H.middleRows(o, 8).setZero();
+        H.middleCols(o, 8).setZero();
+        b.segment(o, 8).setZero();
+      }
+    prior.addTerm(kfs, H, b);
+  } else if (!kfs.empty()) {
     // Fixed dimensions must be zero in the prior's terms (marginalization.h): the gauge keyframe's pose
     // and affine, and the yaw of T_Wm_Wf.
     const int d = layout.stateDim();

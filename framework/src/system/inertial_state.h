@@ -76,7 +76,9 @@ class InertialState {
   // (xi untouched) otherwise or without IMU data over [ref.t_ns, t_ns] on the IMU clock.
   bool frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_c_w, Vec6* xi) const;
 
-  const WindowTerm* term() const { return initialised_ ? term_.get() : nullptr; }
+  // The window term: after the initialisation, and before it with the gyroscope's rotations on.
+  const WindowTerm* term() const { return initialised_ || gyroBeforeInit() ? term_.get() : nullptr; }
+  bool gyroBeforeInit() const { return o_.gyro_bias_sigma_before_init_rad_s > 0.0; }
   const InertialTerm* inertialTerm() const { return term_.get(); }
   GlobalStates& globals() { return globals_; }
   const GlobalStates& globals() const { return globals_; }

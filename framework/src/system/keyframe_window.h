@@ -127,7 +127,12 @@ class KeyframeWindow {
   const RowTiming& timing() const { return timing_; }
 
   // Visual-inertial runs: the inertial part whose terms leave with the keyframes (may be null).
-  void setInertial(InertialState* inertial) { inertial_ = inertial; }
+  // The inertial state; its term joins the bundle adjuster's terms when it has one (before the
+  // initialisation only with the gyroscope's rotations on).
+  void setInertial(InertialState* inertial) {
+    inertial_ = inertial;
+    updateTerms();
+  }
   // Tries the visual-inertial initialisation on the run's keyframe poses (InertialState::tryInitialize);
   // on success the bundle adjuster's terms gain the inertial term. Returns true when it succeeded now.
   bool initializeInertial(const std::vector<ViInitKeyframe>& keyframes);

@@ -179,6 +179,97 @@ TEST(InertialTerm, NormalEquationsMatchNumericDifferencesGlobalShutter) { checkN
 TEST(InertialTerm, NormalEquationsMatchNumericDifferencesRollingShutter) { checkNormalEquations(true, false); }
 TEST(InertialTerm, NormalEquationsMatchNumericDifferencesWithTimeOffset) { checkNormalEquations(true, true); }
 
+// Before the visual-inertial initialisation (layout without the inertial blocks), with the gyroscope's
+// rotations on: each factor's rotation residual on the two poses, weight imu_weight (Cov_RR + (sigma_bg
+// dt)^2 I)^-1 (inertial_term.h). The normal equations against numeric differences of the whitened
+// rotation residuals, block by block; off (sigma 0) the term adds nothing. Shown once: the Jacobian of
+// each factor's first pose negated fails b of poses 0 and 1 and H between consecutive poses.
+TEST(InertialTerm, BeforeTheInitialisationTheGyroRotationsMatchNumericDifferences) {
+  auto makeChain = [] {
+    InertialChain c(true, false);
+    c.layout.inertial = false;
+    return c;
+  };
+  InertialChain c = makeChain();
+  InertialTermOptions o;
+  o.imu_weight = 0.7;
+  o.gyro_bias_sigma_before_init_rad_s = 0.01;
+  auto whitenedRot = [&](const InertialChain& ch) {
+    std::vector<double> out;
+    for (const auto& kf : ch.window) {
+      if (!kf->imu_term) continue;
+      const VisualInertialKeyframe a{kf->imu_prev->state.T_c_w, kf->imu_prev->state.v_wm,
+                                     ImuBias{kf->imu_prev->state.bias_gyro, kf->imu_prev->state.bias_accel}};
+      const VisualInertialKeyframe b{kf->state.T_c_w, kf->state.v_wm, ImuBias{kf->state.bias_gyro, kf->state.bias_accel}};
+      const Vec3 r = visualInertialResidual(*kf->imu_factor, a, b, ch.globals.state.T_wm_wf, ch.T_cm_i,
+                                            ch.globals.state.time_offset_s)
+                         .head<3>();
+      const ImuPreintegration& p = kf->imu_factor->preintegration();
+      const double sb = o.gyro_bias_sigma_before_init_rad_s * p.dt();
+      const Mat3 W = o.imu_weight * (p.covariance().topLeftCorner<3, 3>() + sb * sb * Mat3::Identity()).inverse();
+      const Eigen::LLT<Mat3> llt(W);
+      const Vec3 w = llt.matrixU() * r;  // U^T U = W
+      out.insert(out.end(), w.data(), w.data() + 3);
+    }
+    return Eigen::VectorXd(Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size())));
+  };
+  const int dim = c.dim();
+  ASSERT_EQ(dim, 3 * c.layout.kfDim()) << "no inertial or global blocks before the initialisation";
+  const InertialTerm term(o, c.T_cm_i, &c.globals);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
+  const double e = term.linearize(c.window, c.layout, H, b);
+  const Eigen::VectorXd r0 = whitenedRot(c);
+  ASSERT_EQ(r0.size(), 6);
+  EXPECT_GT(e, 0.0);
+  EXPECT_NEAR(e, r0.squaredNorm(), 1e-9 * std::max(1.0, e));
+  auto f = [&](const Eigen::VectorXd& dx) {
+    InertialChain copy = makeChain();
+    copy.apply(dx);
+    return whitenedRot(copy);
+  };
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(dim);
+  const Eigen::MatrixXd J = test::numericJacobian(f, x0, test::vectorPlus, dim, 1e-6);
+  const Eigen::MatrixXd H_num = J.transpose() * J;
+  const Eigen::VectorXd b_num = -J.transpose() * r0;
+  std::vector<Block> bl;
+  for (int k = 0; k < c.n(); ++k) {
+    bl.push_back({"pose" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kPose, 6});
+    bl.push_back({"twist" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kTwist, 6});
+  }
+  for (const Block& bi : bl) {
+    EXPECT_JACOBIAN_NEAR_TOL(b.segment(bi.offset, bi.size), b_num.segment(bi.offset, bi.size), 1e-5,
+                             1e-6 * std::max(1.0, b_num.segment(bi.offset, bi.size).cwiseAbs().maxCoeff()))
+        << "b of " << bi.name;
+    for (const Block& bj : bl) {
+      const Eigen::MatrixXd hn = H_num.block(bi.offset, bj.offset, bi.size, bj.size);
+      EXPECT_JACOBIAN_NEAR_TOL(H.block(bi.offset, bj.offset, bi.size, bj.size), hn, 1e-5,
+                               1e-6 * std::max(1.0, hn.cwiseAbs().maxCoeff()))
+          << "H of " << bi.name << " x " << bj.name;
+    }
+  }
+  for (int k = 0; k < c.n(); ++k)
+    EXPECT_GT(H.block(bl[2 * k].offset + 3, bl[2 * k].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
+        << "rotation of pose " << k;  // (upsilon; omega): the rotation is the second half
+
+  // Marginalising keyframe 1 takes both factors through it, on the three poses.
+  std::vector<Keyframe*> kfs;
+  Eigen::MatrixXd Hm;
+  Eigen::VectorXd bm;
+  const double em = term.linearizeInvolving(*c.window[1], c.window, c.layout, &kfs, &Hm, &bm);
+  EXPECT_EQ(kfs.size(), 3u);
+  EXPECT_NEAR(em, e, 1e-9 * std::max(1.0, e));
+  EXPECT_LT((Hm - H).cwiseAbs().maxCoeff(), 1e-9 * H.cwiseAbs().maxCoeff());
+
+  // Off: nothing.
+  o.gyro_bias_sigma_before_init_rad_s = 0.0;
+  const InertialTerm off(o, c.T_cm_i, &c.globals);
+  Eigen::MatrixXd H0 = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd b0 = Eigen::VectorXd::Zero(dim);
+  EXPECT_EQ(off.linearize(c.window, c.layout, H0, b0), 0.0);
+  EXPECT_EQ(H0.cwiseAbs().maxCoeff(), 0.0);
+}
+
 // The terms that involve a keyframe, as the marginalisation takes them: keyframe 1's own factor and
 // twist energy and keyframe 2's factor (from 1); scattered back into the window system they equal
 // the window's linearisation minus the terms that do not involve keyframe 1 (the other twists).

@@ -24,6 +24,7 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["time_offset_correction_ms"] = o.time_offset_correction_ms;
   got["frame_twist_from_imu"] = o.frame_twist_from_imu;
   got["smooth_motion_weight"] = o.smooth_motion_weight;
+  got["gyro_bias_sigma_before_init_rad_s"] = o.gyro_bias_sigma_before_init_rad_s;
   got["frame_rotation_from_gyro_before_init"] = o.frame_rotation_from_gyro_before_init;
   got["init_min_keyframes"] = o.init_min_keyframes;
   got["init_min_duration_s"] = o.init_min_duration_s;
@@ -53,6 +54,7 @@ TEST(InertialOptions, TheTablesDefaultsAreTheStructs) {
   EXPECT_EQ(o.enabled, d.enabled);
   EXPECT_EQ(o.frame_twist_from_imu, d.frame_twist_from_imu);
   EXPECT_DOUBLE_EQ(o.smooth_motion_weight, d.smooth_motion_weight);
+  EXPECT_DOUBLE_EQ(o.gyro_bias_sigma_before_init_rad_s, d.gyro_bias_sigma_before_init_rad_s);
   EXPECT_DOUBLE_EQ(o.init_max_imu_chi2, d.init_max_imu_chi2);
   EXPECT_DOUBLE_EQ(o.dynamic_marginalization_interval, d.dynamic_marginalization_interval);
   EXPECT_DOUBLE_EQ(o.fail_grace_s, d.fail_grace_s);

@@ -16,6 +16,13 @@
 //   prior (eq. 32 from the gyroscope reading at t_k, v_k, b_g,k, R_k and T_Wm_Wf) - xi_k, weight
 //   beta * diag((s / sigma_t)^2 x3, (1 / sigma_r)^2 x3): sigma_t [m/s] metric, so in W_f units it is
 //   sigma_t / s; s is the current scale, held constant in the weight (not differentiated).
+// - Before the visual-inertial initialisation (StateLayout::inertial false; on when
+//   gyro_bias_sigma_before_init_rad_s > 0): each linked factor contributes its rotation residual only,
+//   r_R = Log(dR_ij^T R_i^T R_j) (rows 0-2 of the factor's residual, bias and velocities at their
+//   states, which are zero then), on the two keyframes' pose columns. It needs no scale or gravity:
+//   relative rotations are the same in W_f and W_m. Weight imu_weight * (Cov_RR + (sigma_bg dt)^2 I)^-1,
+//   Cov_RR the preintegrated rotation covariance, sigma_bg the option (the bias is not estimated yet).
+//   It keeps the monocular start's world from rotating against the gyroscope (docs/vio.md).
 // - Lifetime (system/ keeps it): a keyframe gets its IMU factor from the newest keyframe when it enters
 //   the window. When a keyframe leaves, every term that involves it (its own factor and twist energy,
 //   the factor of the keyframe whose imu_prev it is) is linearised at the current states into the
@@ -39,6 +46,9 @@ struct InertialTermOptions {
   double twist_weight = 1.0;     // beta of eq. 34 (rolling shutter, twist energy on)
   double twist_sigma_trans_m_s = 0.1;
   double twist_sigma_rot_rad_s = 0.02;
+  // Before the initialisation (layout without the inertial blocks): the gyroscope's relative rotations
+  // (see the contract); the unknown gyro bias enters their covariance with this sigma. <= 0: off.
+  double gyro_bias_sigma_before_init_rad_s = 0.0;
 };
 
 class InertialTerm : public WindowTerm {
