@@ -542,8 +542,8 @@ nlohmann::json Odometry::shutterReport() const {
 std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }
 const DiagnosticsLog& Odometry::diagnostics() const { return impl_->record->diagnostics(); }
 void Odometry::takeDiagnostics(std::vector<ObservationRow>* rows) { impl_->record->takeObservations(rows); }
-// Visual-inertial: points go out in W_m, mapped with T_Wm_Wf as it was when they left the window
-// (points taken before the initialisation stay in W_f; run_record.h, docs/vio.md).
+// Visual-inertial: points go out in W_m, mapped with their host keyframe's scale and the current gravity
+// rotation (points taken before the initialisation stay in W_f; run_record.h, docs/vio.md).
 void Odometry::takePoints(std::vector<MapPoint>* points) { impl_->record->takePoints(points); }
 
 io::Trajectory Odometry::frameTrajectory() const {

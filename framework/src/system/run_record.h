@@ -105,8 +105,10 @@ class RunRecord : public WindowSink {
   const DiagnosticsLog& diagnostics() const { return diag_; }
   // Moves the observation rows out (appended to *rows); the log keeps its header fields and IMU rows.
   void takeObservations(std::vector<ObservationRow>* rows);
-  // Moves the map points that left the window out (appended to *points), as points() maps them
-  // (points that left before the initialisation and are taken before it stay in W_f).
+  // Moves the map points that left the window out (appended to *points), as points() maps them with
+  // the records there are when they are taken (points taken before the initialisation stay in W_f;
+  // those of a keyframe that left in the settling second take the current scale when no settled
+  // record exists yet).
   void takePoints(std::vector<MapPoint>* points);
 
   // Outputs, with the keyframes and points still in `window` at their current state.
