@@ -125,8 +125,10 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
   vo.accel_bias_prior_sigma_m_s2 = o_.accel_bias_prior_sigma_m_s2;
   vo.min_interval_s = o_.init_min_interval_s;
   const ViInitResult r = initializeVisualInertial(kfs, buffer_, sensors_.imu, T_cm_i_, globals_.state.time_offset_s, vo);
+  const int64_t t_newest = window.back()->t_ns;
   if (!r.success) {
     status_ = r.status;
+    if (r.status.rfind("rejected", 0) == 0) noteRefusal(t_newest);
     return false;
   }
   if (r.bias.gyro.norm() > o_.init_max_gyro_bias_rad_s || r.bias.accel.norm() > o_.init_max_accel_bias_m_s2) {
@@ -136,6 +138,7 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
        << " / imu.init_max_accel_bias_m_s2 " << o_.init_max_accel_bias_m_s2
        << " (the keyframe poses do not fit the IMU yet)";
     status_ = os.str();
+    noteRefusal(t_newest);
     return false;
   }
   if (o_.init_max_imu_chi2 > 0.0 && !(r.imu_chi2_mean <= o_.init_max_imu_chi2)) {
@@ -144,6 +147,7 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
        << r.T_wm_wf.scale() << ") above imu.init_max_imu_chi2 " << o_.init_max_imu_chi2
        << " (the keyframe poses do not fit the IMU yet)";
     status_ = os.str();
+    noteRefusal(t_newest);
     return false;
   }
   globals_.state.T_wm_wf = r.T_wm_wf;
@@ -193,6 +197,12 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
      << " s";
   status_ = os.str();
   return true;
+}
+
+void InertialState::noteRefusal(int64_t t_ns) {
+  if (refusals_++ > 0) return;
+  first_refusal_ = status_;
+  first_refusal_t_ns_ = t_ns;
 }
 
 void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& window, DynamicMarginalization& prior) const {

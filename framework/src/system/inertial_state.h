@@ -43,6 +43,12 @@ class InertialState {
   bool enabled() const { return o_.enabled; }
   bool initialised() const { return initialised_; }
   const std::string& status() const { return status_; }  // why it is not initialised yet (or "initialised")
+  // Attempts that had enough data and were refused or rejected (the keyframe poses did not fit the
+  // IMU, or the solution was implausible), and the first of them with the newest keyframe's time: why
+  // an initialisation came late (report.json extra.vio).
+  int refusals() const { return refusals_; }
+  const std::string& firstRefusal() const { return first_refusal_; }
+  int64_t firstRefusalNs() const { return first_refusal_t_ns_; }
   const InertialOptions& options() const { return o_; }
 
   void addImu(const ImuSample& s);
@@ -104,6 +110,10 @@ class InertialState {
   double scale_init_ = 1.0;
   int64_t init_t_ns_ = 0;
   std::string status_ = "waiting for keyframes";
+  int refusals_ = 0;
+  std::string first_refusal_;
+  int64_t first_refusal_t_ns_ = 0;
+  void noteRefusal(int64_t t_ns);  // status_ holds the reason
 };
 
 }  // namespace rsvio

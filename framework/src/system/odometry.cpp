@@ -503,6 +503,11 @@ nlohmann::json Odometry::inertialReport() const {
   nlohmann::json j;
   j["initialised"] = m.inertial->initialised();
   j["status"] = m.inertial->status();
+  j["init_refusals"] = m.inertial->refusals();
+  if (m.inertial->refusals() > 0) {
+    j["init_first_refusal_at_s"] = nsToS(m.inertial->firstRefusalNs());
+    j["init_first_refusal"] = m.inertial->firstRefusal();
+  }
   if (m.inertial->initialised()) {
     j["initialised_at_s"] = nsToS(m.vi_init_t_ns);
     j["scale_at_initialisation"] = m.inertial->initialScale();

@@ -88,6 +88,30 @@ TEST(VisualInertial, WithoutEnoughExcitationItKeepsTrackingVisuallyAndSaysWhy) {
   EXPECT_GE(r.tracked, 40);
 }
 
+// An initialisation whose every attempt is refused (imu.init_max_imu_chi2 below any fit) says how often
+// and why from the first refusal on (report.json extra.vio: init_refusals, init_first_refusal_at_s,
+// init_first_refusal). Measured on tiny_gs: the default run is refused twice (accelerometer bias, at
+// 1.6 and 1.7 s) and initialises at 1.8 s; with the bound every attempt after is refused too. Shown
+// once: with the refusals not counted the test fails (0 against more than 2).
+TEST(VisualInertial, RefusedInitialisationsAreCountedWithTheFirstReason) {
+  const std::string data = simDataset("tiny_gs");
+  const VioOutcome ok = runVio(data, runConfig("gs_vio", {}));
+  ASSERT_TRUE(ok.vio.at("initialised").get<bool>()) << ok.vio.dump();
+  const int ok_refusals = ok.vio.at("init_refusals").get<int>();
+  if (ok_refusals > 0)
+    EXPECT_LE(ok.vio.at("init_first_refusal_at_s").get<double>(), ok.vio.at("initialised_at_s").get<double>());
+  else
+    EXPECT_FALSE(ok.vio.contains("init_first_refusal"));
+
+  const VioOutcome r = runVio(data, runConfig("gs_vio", {"imu.init_max_imu_chi2=1e-12"}));
+  ASSERT_FALSE(r.failed) << r.reason;
+  EXPECT_FALSE(r.vio.at("initialised").get<bool>());
+  EXPECT_GT(r.vio.at("init_refusals").get<int>(), ok_refusals + 2) << r.vio.dump();
+  EXPECT_NE(r.vio.at("status").get<std::string>().find("init_max_imu_chi2"), std::string::npos) << r.vio.dump();
+  EXPECT_NE(r.vio.at("init_first_refusal").get<std::string>().find("refused"), std::string::npos) << r.vio.dump();
+  EXPECT_GT(r.vio.at("init_first_refusal_at_s").get<double>(), 0.0);
+}
+
 // An accelerometer that reads 20 m/s^2 too much on x from 2 s on (after the initialisation) cannot be
 // explained by a slowly walking bias: the run fails with an inertial divergence reason.
 TEST(VisualInertial, ABrokenAccelerometerAfterTheStartIsReportedAsDivergence) {
