@@ -74,7 +74,8 @@ class Odometry {
   bool usesImu() const;
   double scale() const;                            // metres per W_f unit (1 without IMU)
   // Visual-inertial runs: {"initialised", "status" (why not, or how), "initialised_at_s", "scale",
-  // "scale_at_initialisation", "gravity_direction_wf", "time_offset_ms", "time_offset_estimated"};
+  // "scale_at_initialisation", "gravity_direction_wf", "time_offset_ms", "time_offset_estimated",
+  // "init_refusals" and, after a refusal, "init_first_refusal_at_s", "init_first_refusal"};
   // null for visual odometry. usesImu() is true once initialised.
   nlohmann::json inertialReport() const;
   // Rolling shutter (null for a global shutter): the line delay the run ended with, whether it was
