@@ -329,10 +329,14 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
     if (odo.usesImu()) report.scale = odo.scale();
     if (const nlohmann::json vio = odo.inertialReport(); !vio.is_null()) {
       report.extra["vio"] = vio;
-      if (!odo.usesImu())
-        report.warnings.push_back("the visual-inertial initialisation did not succeed (" +
-                                  vio["status"].get<std::string>() + "): the outputs are visual odometry, "
-                                  "camera poses without metric scale");
+      if (!odo.usesImu()) {
+        std::string why = vio["status"].get<std::string>();
+        if (const int n = vio.value("init_refusals", 0); n > 0)
+          why += "; " + std::to_string(n) + " attempts refused since t " +
+                 std::to_string(vio["init_first_refusal_at_s"].get<double>()) + " s";
+        report.warnings.push_back("the visual-inertial initialisation did not succeed (" + why +
+                                  "): the outputs are visual odometry, camera poses without metric scale");
+      }
     }
     if (const nlohmann::json sh = odo.shutterReport(); !sh.is_null()) report.extra["shutter"] = sh;
     for (const auto& w : odo.warnings()) report.warnings.push_back(w);
