@@ -212,32 +212,24 @@ void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& wind
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
   term_->linearizeInvolving(leaving, window, layout, &kfs, &H, &b);
-  if (!kfs.empty() && !initialised_) {
-    // The gyroscope's rotations: on the poses alone, independent of the scale.
-    const int d = layout.stateDim();
-    for (size_t i = 0; i < kfs.size(); ++i)
-      if (kfs[i]->gauge) {
-        const Eigen::Index o = static_cast<Eigen::Index>(i) * d;
-        H.middleRows(o, 8).setZero();
-        H.middleCols(o, 8).setZero();
-        b.segment(o, 8).setZero();
-      }
-    prior.addTerm(kfs, H, b);
-  } else if (!kfs.empty()) {
+  if (!kfs.empty()) {
     // Fixed dimensions must be zero in the prior's terms (marginalization.h): the gauge keyframe's pose
-    // and affine, and the yaw of T_Wm_Wf.
+    // and affine, and (after the initialisation) the yaw of T_Wm_Wf.
     const int d = layout.stateDim();
     std::vector<Eigen::Index> zero;
     for (size_t i = 0; i < kfs.size(); ++i)
       if (kfs[i]->gauge)
         for (int r = 0; r < 8; ++r) zero.push_back(static_cast<Eigen::Index>(i) * d + r);
-    zero.push_back(static_cast<Eigen::Index>(kfs.size()) * d + StateLayout::kGlobalRot + 2);
+    if (initialised_) zero.push_back(static_cast<Eigen::Index>(kfs.size()) * d + StateLayout::kGlobalRot + 2);
     for (Eigen::Index z : zero) {
       H.row(z).setZero();
       H.col(z).setZero();
       b[z] = 0.0;
     }
-    prior.addScaleTerm(kfs, H, b, true);  // IMU factors and the twist energy depend on the scale
+    if (initialised_)
+      prior.addScaleTerm(kfs, H, b, true);  // IMU factors and the twist energy depend on the scale
+    else
+      prior.addTerm(kfs, H, b);  // the gyroscope's rotations alone: on the poses, scale-free
   }
   leaving.imu_term = false;
   leaving.twist_energy = false;
