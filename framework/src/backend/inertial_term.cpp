@@ -89,6 +89,22 @@ bool gyroRotationCols(const Keyframe& j, const GlobalStates& g, const SE3d& T_cm
   return true;
 }
 
+// Before the initialisation: the rotation rows of k's twist energy on its twist (the contract). The
+// prior's rotation -R_Cm_I (w - b_g) needs neither the pose nor T_Wm_Wf (twist_prior.h).
+bool twistRotationCols(const Keyframe& k, const SE3d& T_cm_i, const InertialTermOptions& o, const StateLayout& layout,
+                       Vec3* r, Mat3* W, std::vector<Col>* cols) {
+  if (!layout.rolling || !k.twist_energy || !(o.twist_gyro_sigma_before_init_rad_s > 0.0)) return false;
+  *r = -(T_cm_i.so3() * (k.gyro_at_t - k.state.bias_gyro)) - k.state.twist.tail<3>();
+  const double s = o.twist_gyro_sigma_before_init_rad_s;
+  *W = (o.twist_weight / (s * s)) * Mat3::Identity();
+  if (!cols) return true;
+  cols->clear();
+  Eigen::Matrix<double, 3, 6> J = Eigen::Matrix<double, 3, 6>::Zero();
+  J.rightCols<3>() = -Mat3::Identity();
+  cols->push_back({&k, kPhoto, StateLayout::kTwist, J});
+  return true;
+}
+
 // The twist energy of k: residual, weight and Jacobian blocks.
 bool twistCols(const Keyframe& k, const GlobalStates& g, const SE3d& T_cm_i, const InertialTermOptions& o,
                const StateLayout& layout, Vec6* r, Mat6* W, std::vector<Col>* cols) {
@@ -134,6 +150,7 @@ double InertialTerm::linearize(const KeyframeList& window, const StateLayout& la
       Vec3 r;
       Mat3 W;
       if (gyroRotationCols(*kf, *g_, T_cm_i_, o_, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, H, b);
+      if (twistRotationCols(*kf, T_cm_i_, o_, layout, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, H, b);
       continue;
     }
     Vec15 r;
@@ -154,10 +171,13 @@ double InertialTerm::linearizeInvolving(const Keyframe& kf, const KeyframeList& 
   if (!g_) return 0.0;
   // The terms: kf's factor and twist energy, and the factor of every keyframe whose imu_prev is kf.
   std::vector<const Keyframe*> factor_of, twist_of;
-  if (kf.imu_term && kf.imu_prev && kf.imu_factor) factor_of.push_back(&kf);
-  if (layout.inertial && layout.rolling && kf.twist_energy) twist_of.push_back(&kf);
+  // Before the initialisation a factor contributes only with the gyroscope's rotations on.
+  const bool factors = layout.inertial || o_.gyro_bias_sigma_before_init_rad_s > 0.0;
+  if (factors && kf.imu_term && kf.imu_prev && kf.imu_factor) factor_of.push_back(&kf);
+  if (layout.rolling && kf.twist_energy && (layout.inertial || o_.twist_gyro_sigma_before_init_rad_s > 0.0))
+    twist_of.push_back(&kf);
   for (const auto& w : window)
-    if (w.get() != &kf && w->imu_term && w->imu_prev == &kf && w->imu_factor) factor_of.push_back(w.get());
+    if (factors && w.get() != &kf && w->imu_term && w->imu_prev == &kf && w->imu_factor) factor_of.push_back(w.get());
   auto addKf = [&](const Keyframe* k) {
     if (std::find(kfs->begin(), kfs->end(), k) == kfs->end()) kfs->push_back(const_cast<Keyframe*>(k));
   };
@@ -192,6 +212,12 @@ double InertialTerm::linearizeInvolving(const Keyframe& kf, const KeyframeList& 
     if (imuFactorCols(*j, *g_, T_cm_i_, o_, layout, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, *H, *b);
   }
   for (const Keyframe* k : twist_of) {
+    if (!layout.inertial) {
+      Vec3 r;
+      Mat3 W;
+      if (twistRotationCols(*k, T_cm_i_, o_, layout, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, *H, *b);
+      continue;
+    }
     Vec6 r;
     Mat6 W;
     if (twistCols(*k, *g_, T_cm_i_, o_, layout, &r, &W, &cols)) e += accumulate(r, W, cols, rowOf, *H, *b);

@@ -296,7 +296,13 @@ bool MonoInitializer::tryInitialise() {
   // Each image's rotation rate needs two frame pairs at each end (with 3 frames after the reference
   // the two ends share their middle pair).
   const int last = static_cast<int>(hist_pts_.size()) - 1;
-  if (options_.init_rotation_rates && timing_.dtDv() != 0.0 && last >= 3)
+  const bool rates_wanted = options_.init_rotation_rates && timing_.dtDv() != 0.0;
+  bool from_source = false;
+  if (rates_wanted && rate_source_)
+    from_source = rate_source_(hist_t_ns_.front(), &tvo.w_ref) && rate_source_(hist_t_ns_.back(), &tvo.w_cur);
+  if (from_source)
+    tvo.use_rates = true;
+  else if (rates_wanted && last >= 3)
     tvo.use_rates = rateAt(0, 0, &tvo.w_ref) && rateAt(last - 2, last, &tvo.w_cur);
   const TwoViewResult r = solveTwoView(ref_px, cur_px, camera_, timing_, nsToS(cur_t_ns_ - ref_t_ns_),
                                        0x5eed1234u + static_cast<uint64_t>(ref_index_), tvo);
@@ -309,6 +315,7 @@ bool MonoInitializer::tryInitialise() {
   T_cur_ref_ = r.T_cur_ref;
   xi_ = r.xi;
   rates_used_ = tvo.use_rates;
+  rates_from_source_ = from_source;
   xi_ref_ = tvo.use_rates ? r.xi_ref : r.xi;
   xi_cur_ = tvo.use_rates ? r.xi_cur : r.xi;
   return true;

@@ -24,6 +24,7 @@ bool SmoothMotionTerm::evaluate(const Keyframe& k, Eval* e) const {
   e->d_r_d_Ta = SE3d::rightJacobianInverse(u) / D;
   const double f = D > o_.gap_ref_s ? (o_.gap_ref_s / D) * (o_.gap_ref_s / D) : 1.0;
   e->W = o_.information * (f * k.motion_weight);
+  e->W.bottomRightCorner<3, 3>() *= k.motion_weight_rot;
   return true;
 }
 

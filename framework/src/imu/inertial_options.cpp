@@ -28,12 +28,21 @@ ParamTable inertialParamTable() {
       paramBool("frame_rotation_from_gyro_before_init", d.frame_rotation_from_gyro_before_init,
                 "with frame_twist_from_imu, before the initialisation: the frame twist's rotation from the gyroscope "
                 "at the frame's time (gyro bias 0), its translation from the tracked frames"),
+      paramBool("init_rates_from_gyro", d.init_rates_from_gyro,
+                "rolling shutter: the monocular start's rotation rate of each image from the gyroscope at its time "
+                "(gyro bias 0) instead of from the corner tracks (backend.init_rotation_rates)"),
       paramDouble("smooth_motion_weight", d.smooth_motion_weight, 0.0, 1e6, "",
                   "rolling shutter: weight of the smooth-motion twist prior of keyframes that have the IMU twist "
                   "energy (after the initialisation); 1: the same as before it"),
       paramDouble("gyro_bias_sigma_before_init_rad_s", d.gyro_bias_sigma_before_init_rad_s, 0.0, 10.0, "rad/s",
                   "before the initialisation: the gyroscope's relative rotations between keyframes in the window, "
                   "with this sigma for the gyro bias not estimated yet; 0: off"),
+      paramDouble("twist_gyro_sigma_before_init_rad_s", d.twist_gyro_sigma_before_init_rad_s, 0.0, 10.0, "rad/s",
+                  "rolling shutter, before the initialisation: each keyframe's twist rotation held to the gyroscope "
+                  "at its time with this sigma (noise and the gyro bias not estimated yet); 0: off"),
+      paramDouble("smooth_motion_rot_weight_before_init", d.smooth_motion_rot_weight_before_init, 0.0, 1e6, "",
+                  "with twist_gyro_sigma_before_init_rad_s: the weight of the smooth-motion prior's rotation rows on "
+                  "keyframes whose twist rotation the gyroscope holds; 1: as without it"),
       paramInt("init_min_keyframes", d.init_min_keyframes, 3, 1000, "",
                "keyframes before the visual-inertial initialisation is tried"),
       paramDouble("init_min_duration_s", d.init_min_duration_s, 0.0, 1e6, "s",
@@ -93,6 +102,9 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.smooth_motion_weight = p.getDouble("smooth_motion_weight");
   o.gyro_bias_sigma_before_init_rad_s = p.getDouble("gyro_bias_sigma_before_init_rad_s");
   o.frame_rotation_from_gyro_before_init = p.getBool("frame_rotation_from_gyro_before_init");
+  o.init_rates_from_gyro = p.getBool("init_rates_from_gyro");
+  o.twist_gyro_sigma_before_init_rad_s = p.getDouble("twist_gyro_sigma_before_init_rad_s");
+  o.smooth_motion_rot_weight_before_init = p.getDouble("smooth_motion_rot_weight_before_init");
   o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));
   o.init_min_duration_s = p.getDouble("init_min_duration_s");
   o.init_min_accel_excitation_m_s2 = p.getDouble("init_min_accel_excitation_m_s2");

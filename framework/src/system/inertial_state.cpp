@@ -32,6 +32,7 @@ InertialState::InertialState(const InertialOptions& o, const SensorSetup& sensor
   to.imu_weight = o.imu_weight;
   to.twist_weight = o.twist_weight;
   to.gyro_bias_sigma_before_init_rad_s = o.gyro_bias_sigma_before_init_rad_s;
+  to.twist_gyro_sigma_before_init_rad_s = o.twist_gyro_sigma_before_init_rad_s;
   if (twist_sigma_t_ > 0.0) to.twist_sigma_trans_m_s = twist_sigma_t_;
   if (twist_sigma_r_ > 0.0) to.twist_sigma_rot_rad_s = twist_sigma_r_;
   term_ = std::make_unique<InertialTerm>(to, T_cm_i_, &globals_);
@@ -67,6 +68,12 @@ std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
   kf.imu_term = false;
   kf.imu_prev = nullptr;
   kf.imu_factor.reset();
+  if (!initialised_ && twistBeforeInit()) {
+    // Before the initialisation, optionally: the twist energy's rotation rows (inertial_term.h), and
+    // the gyroscope's rate as the twist's starting rotation.
+    linkTwistEnergy(kf);
+    if (kf.twist_energy) kf.state.twist.tail<3>() = -(T_cm_i_.so3() * (kf.gyro_at_t - kf.state.bias_gyro));
+  }
   if (!newest) return "";
   if (!initialised_) {
     // Before the initialisation, optionally: the factor for its rotation alone (inertial_term.h).
@@ -206,7 +213,7 @@ void InertialState::noteRefusal(int64_t t_ns) {
 }
 
 void InertialState::marginalizeTerms(Keyframe& leaving, const KeyframeList& window, DynamicMarginalization& prior) const {
-  if (!initialised_ && !gyroBeforeInit()) return;
+  if (!initialised_ && !termsBeforeInit()) return;
   const StateLayout layout = prior.layout();
   std::vector<Keyframe*> kfs;
   Eigen::MatrixXd H;
@@ -315,13 +322,20 @@ void InertialState::fillMotionState(const Keyframe& ref, MotionState* ms) const 
 bool InertialState::frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_c_w, Vec6* xi) const {
   if (!rolling_ || !o_.frame_twist_from_imu) return false;
   if (!initialised_) {  // no scale, velocity or bias yet: eq. 25's rotation from the gyroscope alone
-    const int64_t t = t_ns + offsetNs();
-    if (!o_.frame_rotation_from_gyro_before_init || !buffer_.covers(t, t)) return false;
-    xi->tail<3>() = -(T_cm_i_.so3() * (buffer_.interpolate(t).gyro_rad_s - ref.state.bias_gyro));
+    Vec3 w;
+    if (!o_.frame_rotation_from_gyro_before_init || !gyroRate(t_ns, ref.state.bias_gyro, &w)) return false;
+    xi->tail<3>() = w;
     return true;
   }
   return imuFrameTwist(buffer_, sensors_.imu, imuStateOf(visualInertialStateOf(ref), globals_.state.T_wm_wf, T_cm_i_),
                        ref.t_ns, t_ns, globals_.state.time_offset_s, T_c_w, globals_.state.T_wm_wf, T_cm_i_, xi);
+}
+
+bool InertialState::gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const {
+  const int64_t t = t_ns + offsetNs();
+  if (!buffer_.covers(t, t)) return false;
+  *w = -(T_cm_i_.so3() * (buffer_.interpolate(t).gyro_rad_s - bias_gyro));
+  return true;
 }
 
 }  // namespace rsvio

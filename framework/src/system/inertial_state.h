@@ -81,10 +81,16 @@ class InertialState {
   // options().frame_rotation_from_gyro_before_init: only xi's rotation, -R_Cm_I (gyro - b_g). False
   // (xi untouched) otherwise or without IMU data over [ref.t_ns, t_ns] on the IMU clock.
   bool frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_c_w, Vec6* xi) const;
+  // The camera's rotation rate from the gyroscope at camera time t_ns (the rotation part of a twist,
+  // left of T_Cf_Wf: -R_Cm_I (gyro - b_g), rad/s) with the gyro bias b_g given. Needs no scale or
+  // gravity, so it serves before the initialisation. False without an IMU sample around t_ns + offset.
+  bool gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const;
 
   // The window term: after the initialisation, and before it with the gyroscope's rotations on.
-  const WindowTerm* term() const { return initialised_ || gyroBeforeInit() ? term_.get() : nullptr; }
+  const WindowTerm* term() const { return initialised_ || termsBeforeInit() ? term_.get() : nullptr; }
   bool gyroBeforeInit() const { return o_.gyro_bias_sigma_before_init_rad_s > 0.0; }
+  bool twistBeforeInit() const { return rolling_ && o_.twist_gyro_sigma_before_init_rad_s > 0.0; }
+  bool termsBeforeInit() const { return gyroBeforeInit() || twistBeforeInit(); }
   const InertialTerm* inertialTerm() const { return term_.get(); }
   GlobalStates& globals() { return globals_; }
   const GlobalStates& globals() const { return globals_; }

@@ -51,6 +51,7 @@ class MonoStart {
   const Vec6& xiRef() const { return initializer_.xiRef(); }
   const Vec6& xiCur() const { return initializer_.xiCur(); }
   const std::string& status() const { return initializer_.status(); }
+  void setRateSource(MonoInitializer::RateSource source) { initializer_.setRateSource(std::move(source)); }
   void clear() { frames_.clear(); }
 
  private:

@@ -111,6 +111,10 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
       if (m->twistEnergySigma(&sigma_t, &sigma_r)) break;
     inertial = std::make_unique<InertialState>(io, sensors, rolling, sigma_t, sigma_r, window->globals());
     window->setInertial(inertial.get());
+    if (rolling && io.init_rates_from_gyro) {
+      const InertialState* in = inertial.get();
+      start->setRateSource([in](int64_t t_ns, Vec3* w) { return in->gyroRate(t_ns, Vec3::Zero(), w); });
+    }
     record->setGlobals(&window->globals());
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
@@ -132,6 +136,19 @@ void Odometry::Impl::tryInertialInitialisation() {
     vi_init_t_ns = window->newest().t_ns;
     record->setMetric(window->newest().t_ns);
   }
+}
+
+// A new keyframe's inertial terms (InertialState::onNewKeyframe) and the weights of its smooth-motion
+// prior where the IMU measures its twist: the whole twist after the initialisation
+// (imu.smooth_motion_weight), the rotation alone before it (imu.smooth_motion_rot_weight_before_init).
+void Odometry::Impl::linkInertial(Keyframe& kf) {
+  const std::string w = inertial->onNewKeyframe(kf, window->empty() ? nullptr : &window->newest());
+  if (!w.empty()) record->addWarning(w);
+  if (!kf.twist_energy) return;
+  if (inertial->initialised())
+    kf.motion_weight = inertial->options().smooth_motion_weight;
+  else
+    kf.motion_weight_rot = inertial->options().smooth_motion_rot_weight_before_init;
 }
 
 void Odometry::Impl::fillInertial(int64_t t_ns) {
@@ -256,11 +273,7 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
       kf->twist_prior = tp;
     }
   }
-  if (inertial && !window->empty()) {
-    const std::string w = inertial->onNewKeyframe(*kf, &window->newest());
-    if (!w.empty()) record->addWarning(w);
-    if (kf->twist_energy) kf->motion_weight = inertial->options().smooth_motion_weight;
-  }
+  if (inertial) linkInertial(*kf);
   Keyframe& nk = window->insert(std::move(kf));
   {
     ScopedStage st(record->stages(), "activate");
@@ -376,6 +389,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
     kf0->state.twist = own_twists ? start->xiRef() : start->xi();
     kf0->twist_start = kf0->state.twist;
   }
+  if (inertial) linkInertial(*kf0);
   Keyframe& k0 = window->insert(std::move(kf0));  // the first keyframe: the gauge
   if (FrameRecord* r = record->frame(ref.index)) {
     r->keyframe = true;

@@ -80,7 +80,8 @@ struct Odometry::Impl {
   // An estimated line delay: the window's current value to the timing the tracker and record use.
   void syncLineDelay();
   void tryInertialInitialisation();
-  void fillInertial(int64_t t_ns);   // the history entry of t_ns gets its inertial fields (VIO)
+  void fillInertial(int64_t t_ns);  // the history entry of t_ns gets its inertial fields (VIO)
+  void linkInertial(Keyframe& kf);  // a new keyframe's inertial terms and smooth-motion weights (VIO)
   // Camera poses in W_f -> body poses in W_m (VIO, after the initialisation), pose i with T_wm_wf[i]
   // (RunRecord's per-pose transforms).
   io::Trajectory toBody(io::Trajectory t, const std::vector<RxSO3d>& T_wm_wf) const;

@@ -137,6 +137,22 @@ std::vector<Block> blocks(const InertialChain& c) {
   return out;
 }
 
+// The window system (H, b) against the numeric one, block by block, each against its own scale.
+void expectBlocksNear(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const Eigen::MatrixXd& H_num,
+                      const Eigen::VectorXd& b_num, const std::vector<Block>& bl) {
+  for (const Block& bi : bl) {
+    EXPECT_JACOBIAN_NEAR_TOL(b.segment(bi.offset, bi.size), b_num.segment(bi.offset, bi.size), 1e-5,
+                             1e-6 * std::max(1.0, b_num.segment(bi.offset, bi.size).cwiseAbs().maxCoeff()))
+        << "b of " << bi.name;
+    for (const Block& bj : bl) {
+      const Eigen::MatrixXd hn = H_num.block(bi.offset, bj.offset, bi.size, bj.size);
+      EXPECT_JACOBIAN_NEAR_TOL(H.block(bi.offset, bj.offset, bi.size, bj.size), hn, 1e-5,
+                               1e-6 * std::max(1.0, hn.cwiseAbs().maxCoeff()))
+          << "H of " << bi.name << " x " << bj.name;
+    }
+  }
+}
+
 void checkNormalEquations(bool rolling, bool offset) {
   InertialChain c(rolling, offset);
   InertialTermOptions o;
@@ -158,17 +174,7 @@ void checkNormalEquations(bool rolling, bool offset) {
   const Eigen::MatrixXd J = test::numericJacobian(f, x0, test::vectorPlus, c.dim(), 1e-6);
   const Eigen::MatrixXd H_num = J.transpose() * J;
   const Eigen::VectorXd b_num = -J.transpose() * r0;
-  for (const Block& bi : blocks(c)) {
-    EXPECT_JACOBIAN_NEAR_TOL(b.segment(bi.offset, bi.size), b_num.segment(bi.offset, bi.size), 1e-5,
-                             1e-6 * std::max(1.0, b_num.segment(bi.offset, bi.size).cwiseAbs().maxCoeff()))
-        << "b of " << bi.name;
-    for (const Block& bj : blocks(c)) {
-      const Eigen::MatrixXd hn = H_num.block(bi.offset, bj.offset, bi.size, bj.size);
-      EXPECT_JACOBIAN_NEAR_TOL(H.block(bi.offset, bj.offset, bi.size, bj.size), hn, 1e-5,
-                               1e-6 * std::max(1.0, hn.cwiseAbs().maxCoeff()))
-          << "H of " << bi.name << " x " << bj.name;
-    }
-  }
+  expectBlocksNear(H, b, H_num, b_num, blocks(c));
   // Every block is reached: no block of the system is left without information.
   for (const Block& bi : blocks(c)) {
     EXPECT_GT(H.block(bi.offset, bi.offset, bi.size, bi.size).diagonal().minCoeff(), 0.0) << bi.name;
@@ -237,17 +243,7 @@ TEST(InertialTerm, BeforeTheInitialisationTheGyroRotationsMatchNumericDifference
     bl.push_back({"pose" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kPose, 6});
     bl.push_back({"twist" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kTwist, 6});
   }
-  for (const Block& bi : bl) {
-    EXPECT_JACOBIAN_NEAR_TOL(b.segment(bi.offset, bi.size), b_num.segment(bi.offset, bi.size), 1e-5,
-                             1e-6 * std::max(1.0, b_num.segment(bi.offset, bi.size).cwiseAbs().maxCoeff()))
-        << "b of " << bi.name;
-    for (const Block& bj : bl) {
-      const Eigen::MatrixXd hn = H_num.block(bi.offset, bj.offset, bi.size, bj.size);
-      EXPECT_JACOBIAN_NEAR_TOL(H.block(bi.offset, bj.offset, bi.size, bj.size), hn, 1e-5,
-                               1e-6 * std::max(1.0, hn.cwiseAbs().maxCoeff()))
-          << "H of " << bi.name << " x " << bj.name;
-    }
-  }
+  expectBlocksNear(H, b, H_num, b_num, bl);
   for (int k = 0; k < c.n(); ++k)
     EXPECT_GT(H.block(bl[2 * k].offset + 3, bl[2 * k].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
         << "rotation of pose " << k;  // (upsilon; omega): the rotation is the second half
@@ -263,6 +259,77 @@ TEST(InertialTerm, BeforeTheInitialisationTheGyroRotationsMatchNumericDifference
 
   // Off: nothing.
   o.gyro_bias_sigma_before_init_rad_s = 0.0;
+  const InertialTerm off(o, c.T_cm_i, &c.globals);
+  Eigen::MatrixXd H0 = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd b0 = Eigen::VectorXd::Zero(dim);
+  EXPECT_EQ(off.linearize(c.window, c.layout, H0, b0), 0.0);
+  EXPECT_EQ(H0.cwiseAbs().maxCoeff(), 0.0);
+}
+
+// Before the initialisation with imu.twist_gyro_sigma_before_init_rad_s: each keyframe's twist rotation
+// is held to the gyroscope, r = -R_Cm_I (w - b_g) - xi_rot (the rotation rows of eq. 33, which need no
+// pose, scale or gravity), weight twist_weight / sigma^2; numeric differences per block, the terms
+// through a keyframe for the marginalisation, and nothing when off.
+TEST(InertialTerm, BeforeTheInitialisationTheTwistRotationsFollowTheGyroscope) {
+  auto makeChain = [] {
+    InertialChain c(true, false);
+    c.layout.inertial = false;
+    return c;
+  };
+  InertialChain c = makeChain();
+  InertialTermOptions o;
+  o.twist_weight = 0.6;
+  o.twist_gyro_sigma_before_init_rad_s = 0.03;
+  auto whitenedTwistRot = [&](const InertialChain& ch) {
+    std::vector<double> out;
+    for (const auto& kf : ch.window) {
+      const Vec6 r6 = twistResidual(kf->state.twist, kf->gyro_at_t, kf->state.v_wm, kf->state.bias_gyro,
+                                    kf->state.T_c_w, ch.globals.state.T_wm_wf, ch.T_cm_i);
+      const Vec3 w = std::sqrt(o.twist_weight) / o.twist_gyro_sigma_before_init_rad_s * r6.tail<3>();
+      out.insert(out.end(), w.data(), w.data() + 3);
+    }
+    return Eigen::VectorXd(Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size())));
+  };
+  const int dim = c.dim();
+  const InertialTerm term(o, c.T_cm_i, &c.globals);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
+  const double e = term.linearize(c.window, c.layout, H, b);
+  const Eigen::VectorXd r0 = whitenedTwistRot(c);
+  ASSERT_EQ(r0.size(), 9);
+  EXPECT_GT(e, 0.0);
+  EXPECT_NEAR(e, r0.squaredNorm(), 1e-9 * std::max(1.0, e));
+  auto f = [&](const Eigen::VectorXd& dx) {
+    InertialChain copy = makeChain();
+    copy.apply(dx);
+    return whitenedTwistRot(copy);
+  };
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(dim);
+  const Eigen::MatrixXd J = test::numericJacobian(f, x0, test::vectorPlus, dim, 1e-6);
+  const Eigen::MatrixXd H_num = J.transpose() * J;
+  const Eigen::VectorXd b_num = -J.transpose() * r0;
+  std::vector<Block> bl;
+  for (int k = 0; k < c.n(); ++k) {
+    bl.push_back({"pose" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kPose, 6});
+    bl.push_back({"twist" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kTwist, 6});
+  }
+  expectBlocksNear(H, b, H_num, b_num, bl);
+  for (int k = 0; k < c.n(); ++k)
+    EXPECT_GT(H.block(bl[2 * k + 1].offset + 3, bl[2 * k + 1].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
+        << "twist rotation of keyframe " << k;
+
+  // Marginalising keyframe 1 takes its own twist term only (one keyframe).
+  std::vector<Keyframe*> kfs;
+  Eigen::MatrixXd Hm;
+  Eigen::VectorXd bm;
+  const double em = term.linearizeInvolving(*c.window[1], c.window, c.layout, &kfs, &Hm, &bm);
+  ASSERT_EQ(kfs.size(), 1u);
+  EXPECT_NEAR(em, r0.segment<3>(3).squaredNorm(), 1e-9 * std::max(1.0, em));
+  const int o1 = c.layout.photometricOffset(1), kd = c.layout.kfDim();
+  EXPECT_LT((Hm.topLeftCorner(kd, kd) - H.block(o1, o1, kd, kd)).cwiseAbs().maxCoeff(), 1e-9 * H.cwiseAbs().maxCoeff());
+
+  // Off: nothing.
+  o.twist_gyro_sigma_before_init_rad_s = 0.0;
   const InertialTerm off(o, c.T_cm_i, &c.globals);
   Eigen::MatrixXd H0 = Eigen::MatrixXd::Zero(dim, dim);
   Eigen::VectorXd b0 = Eigen::VectorXd::Zero(dim);

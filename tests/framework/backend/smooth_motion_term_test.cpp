@@ -101,6 +101,14 @@ TEST(SmoothMotionTerm, CentralBackwardAndForwardDifferencesAndTheGapWeight) {
   c.window[1]->state.twist = central;
   ASSERT_TRUE(term.evaluate(*c.window[1], &e));
   EXPECT_LT(e.r.norm(), 1e-12);
+  // The weights a keyframe carries: motion_weight on all rows, motion_weight_rot on the rotation rows
+  // too (a keyframe whose twist rotation the gyroscope holds before the initialisation).
+  c.window[0]->motion_weight = 0.5;
+  c.window[0]->motion_weight_rot = 0.1;
+  ASSERT_TRUE(term.evaluate(*c.window[0], &e));
+  EXPECT_DOUBLE_EQ(e.W(0, 0), 40.0 * 0.5);
+  EXPECT_DOUBLE_EQ(e.W(3, 3), 90.0 * 0.5 * 0.1);
+  EXPECT_DOUBLE_EQ(e.W(5, 5), 90.0 * 0.5 * 0.1);
   c.window[1]->motion_term = false;  // marginalised: no term
   EXPECT_FALSE(term.evaluate(*c.window[1], &e));
 }

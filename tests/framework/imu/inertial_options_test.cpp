@@ -26,6 +26,9 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["smooth_motion_weight"] = o.smooth_motion_weight;
   got["gyro_bias_sigma_before_init_rad_s"] = o.gyro_bias_sigma_before_init_rad_s;
   got["frame_rotation_from_gyro_before_init"] = o.frame_rotation_from_gyro_before_init;
+  got["init_rates_from_gyro"] = o.init_rates_from_gyro;
+  got["twist_gyro_sigma_before_init_rad_s"] = o.twist_gyro_sigma_before_init_rad_s;
+  got["smooth_motion_rot_weight_before_init"] = o.smooth_motion_rot_weight_before_init;
   got["init_min_keyframes"] = o.init_min_keyframes;
   got["init_min_duration_s"] = o.init_min_duration_s;
   got["init_min_accel_excitation_m_s2"] = o.init_min_accel_excitation_m_s2;

@@ -23,6 +23,11 @@
 //   relative rotations are the same in W_f and W_m. Weight imu_weight * (Cov_RR + (sigma_bg dt)^2 I)^-1,
 //   Cov_RR the preintegrated rotation covariance, sigma_bg the option (the bias is not estimated yet).
 //   It keeps the monocular start's world from rotating against the gyroscope (docs/vio.md).
+// - Before the initialisation, rolling shutter (on when twist_gyro_sigma_before_init_rad_s > 0): each
+//   keyframe with twist_energy contributes the rotation rows of its twist energy alone,
+//   r = -R_Cm_I (w - b_g) - xi_rot (eq. 32's rotation: no pose, scale or gravity in it), on its twist
+//   columns, weight twist_weight / sigma^2 I. It holds the twists' rotation to the gyroscope where the
+//   smooth-motion prior's finite differences lag a changing rate (docs/vio.md).
 // - Lifetime (system/ keeps it): a keyframe gets its IMU factor from the newest keyframe when it enters
 //   the window. When a keyframe leaves, every term that involves it (its own factor and twist energy,
 //   the factor of the keyframe whose imu_prev it is) is linearised at the current states into the
@@ -49,6 +54,9 @@ struct InertialTermOptions {
   // Before the initialisation (layout without the inertial blocks): the gyroscope's relative rotations
   // (see the contract); the unknown gyro bias enters their covariance with this sigma. <= 0: off.
   double gyro_bias_sigma_before_init_rad_s = 0.0;
+  // Before the initialisation, rolling shutter: the twist energy's rotation rows (see the contract)
+  // with this sigma. <= 0: off.
+  double twist_gyro_sigma_before_init_rad_s = 0.0;
 };
 
 class InertialTerm : public WindowTerm {

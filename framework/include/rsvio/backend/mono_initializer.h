@@ -39,9 +39,12 @@
 //   image's central pose with that rate (exp(-[w] tau), no depth needed), and the essential matrix is
 //   fitted on those bearings. The rounds above are then not run (they would put one average twist
 //   back). xiRef() and xiCur() hand the images' twists on: the measured rates and the fit's average
-//   translation velocity. Figures: docs/rolling_shutter.md, "The start".
+//   translation velocity. Figures: docs/rolling_shutter.md, "The start". With a rate source
+//   (setRateSource: the gyroscope in a visual-inertial run, imu.init_rates_from_gyro) the rates are
+//   the source's at each image's timestamp, from the first frame after the reference on.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
@@ -116,6 +119,14 @@ class MonoInitializer {
   const Vec6& xiRef() const { return xi_ref_; }
   const Vec6& xiCur() const { return xi_cur_; }
   double medianParallaxDeg() const { return parallax_deg_; }
+  // Rolling shutter with init_rotation_rates: where the source gives an image's rotation rate (the
+  // rotation part of a twist, left form, rad/s, at the image's camera timestamp t_ns; the gyroscope
+  // in a visual-inertial run), it replaces the rate fitted from the corner tracks, and it is used from
+  // the first frame after the reference on. A source that returns false for either image leaves the
+  // fitted rates (or none) for that attempt.
+  using RateSource = std::function<bool(int64_t t_ns, Eigen::Vector3d* w)>;
+  void setRateSource(RateSource source) { rate_source_ = std::move(source); }
+  bool ratesFromSource() const { return rates_from_source_; }
   const std::string& status() const { return status_; }  // one line: what the last attempt found
   int numTracks() const { return static_cast<int>(cur_pts_.size()); }
 
@@ -138,6 +149,8 @@ class MonoInitializer {
   // back() = cur_pts_) and their timestamps, for the rotation rates.
   std::vector<std::vector<cv::Point2f>> hist_pts_;
   std::vector<int64_t> hist_t_ns_;
+  RateSource rate_source_;
+  bool rates_from_source_ = false;
   SE3d T_cur_ref_;
   Vec6 xi_ = Vec6::Zero(), xi_ref_ = Vec6::Zero(), xi_cur_ = Vec6::Zero();
   double parallax_deg_ = 0.0;

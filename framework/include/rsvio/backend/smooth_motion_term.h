@@ -11,9 +11,11 @@
 //   window.h. With both neighbours it is the central difference of the optimised neighbour poses;
 //   a keyframe that is the newest (no next yet) gets the backward difference, the first keyframe of a
 //   run the forward one.
-// - Energy r^T W r, W = information * min(1, (gap_ref_s / (t_b - t_a))^2) * Keyframe::motion_weight:
-//   the constant-twist assumption degrades with the time the difference spans; a keyframe whose twist
-//   the IMU measures (twist energy) may weigh it less (InertialOptions::smooth_motion_weight).
+// - Energy r^T W r, W = information * min(1, (gap_ref_s / (t_b - t_a))^2) * Keyframe::motion_weight,
+//   the rotation rows (3-5) also * Keyframe::motion_weight_rot: the constant-twist assumption
+//   degrades with the time the difference spans; a keyframe whose twist the IMU measures (twist
+//   energy) may weigh it less (InertialOptions::smooth_motion_weight), or its rotation alone before
+//   the initialisation (InertialOptions::smooth_motion_rot_weight_before_init).
 // - Jacobians (LEFT pose perturbations T <- exp(d) T, rsvio/lie/lie.h; twists additive), with
 //   u = log(T_b T_a^-1), D = t_b - t_a:
 //     d r / d xi_k = I,   d r / d T_b = -Jl^-1(u) / D,   d r / d T_a = +Jr^-1(u) / D

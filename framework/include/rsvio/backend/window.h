@@ -146,6 +146,7 @@ struct Keyframe {
   // neighbours (nullptr: none) and whether its term is still active (false once marginalised).
   bool motion_term = false;
   double motion_weight = 1.0;  // multiplies the term's information (set when the keyframe is made)
+  double motion_weight_rot = 1.0;  // multiplies its rotation rows as well (the gyroscope holds them)
   Keyframe* motion_prev = nullptr;
   Keyframe* motion_next = nullptr;
   // Visual-inertial terms (backend/inertial_term.h): the IMU factor from imu_prev to this keyframe,

@@ -31,6 +31,10 @@ struct InertialOptions {
   // at the frame's time (eq. 25's rotation, gyro bias 0), its translation as without the IMU. Off: it
   // did not keep the early losses from happening (same section).
   bool frame_rotation_from_gyro_before_init = false;
+  // Rolling shutter: the monocular start's rotation rate of each of its two images from the gyroscope
+  // at the image's time (gyro bias 0) instead of fitted from the corner tracks
+  // (backend.init_rotation_rates, MonoInitializer::setRateSource); the two keyframes start with them.
+  bool init_rates_from_gyro = false;
   // Rolling shutter: the weight of the smooth-motion twist prior (backend/smooth_motion_term.h) of a
   // keyframe that has the IMU twist energy (made after the initialisation); 1: as before it. Lighter
   // weights lost track or were less accurate (docs/vio.md, same section).
@@ -43,6 +47,12 @@ struct InertialOptions {
   // 207 to 6.4 mm, but over the ten Table I sequences the tracking losses move rather than fall, so it
   // stays off (docs/vio.md, "The gyroscope before the initialisation").
   double gyro_bias_sigma_before_init_rad_s = 0.0;
+  // Rolling shutter, before the initialisation: each keyframe's twist energy with its rotation rows
+  // alone (the gyroscope at the keyframe's time, gyro bias 0: r = -R_Cm_I w_meas - xi_rot), with this
+  // sigma [rad/s] for the gyroscope's noise and the bias not estimated yet; the smooth-motion prior's
+  // rotation rows on those keyframes weigh smooth_motion_rot_weight_before_init. 0: off.
+  double twist_gyro_sigma_before_init_rad_s = 0.0;
+  double smooth_motion_rot_weight_before_init = 1.0;
   // Visual-inertial initialisation (vi_init.h), tried at every new keyframe until it succeeds.
   int init_min_keyframes = 8;
   double init_min_duration_s = 1.5;
