@@ -307,6 +307,7 @@ bool MonoInitializer::tryInitialise() {
   const TwoViewResult r = solveTwoView(ref_px, cur_px, camera_, timing_, nsToS(cur_t_ns_ - ref_t_ns_),
                                        0x5eed1234u + static_cast<uint64_t>(ref_index_), tvo);
   status_ = r.status;
+  if (from_source) status_ += ", the rates from the gyroscope";
   parallax_deg_ = r.parallax_deg;
   if (!r.found) return false;
   if (r.inlier_ratio < options_.init_min_inlier_ratio || r.front < 0.9 * static_cast<double>(r.inliers) ||
@@ -315,7 +316,6 @@ bool MonoInitializer::tryInitialise() {
   T_cur_ref_ = r.T_cur_ref;
   xi_ = r.xi;
   rates_used_ = tvo.use_rates;
-  rates_from_source_ = from_source;
   xi_ref_ = tvo.use_rates ? r.xi_ref : r.xi;
   xi_cur_ = tvo.use_rates ? r.xi_cur : r.xi;
   return true;

@@ -126,7 +126,6 @@ class MonoInitializer {
   // fitted rates (or none) for that attempt.
   using RateSource = std::function<bool(int64_t t_ns, Eigen::Vector3d* w)>;
   void setRateSource(RateSource source) { rate_source_ = std::move(source); }
-  bool ratesFromSource() const { return rates_from_source_; }
   const std::string& status() const { return status_; }  // one line: what the last attempt found
   int numTracks() const { return static_cast<int>(cur_pts_.size()); }
 
@@ -150,7 +149,6 @@ class MonoInitializer {
   std::vector<std::vector<cv::Point2f>> hist_pts_;
   std::vector<int64_t> hist_t_ns_;
   RateSource rate_source_;
-  bool rates_from_source_ = false;
   SE3d T_cur_ref_;
   Vec6 xi_ = Vec6::Zero(), xi_ref_ = Vec6::Zero(), xi_cur_ = Vec6::Zero();
   double parallax_deg_ = 0.0;
