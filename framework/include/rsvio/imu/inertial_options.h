@@ -28,8 +28,9 @@ struct InertialOptions {
   // rs_vio's median ATE from 58 to 36 mm (docs/vio.md, "The IMU's twist in the tracker").
   bool frame_twist_from_imu = true;
   // With frame_twist_from_imu, before the initialisation: the frame twist's rotation from the gyroscope
-  // at the frame's time (eq. 25's rotation, gyro bias 0), its translation as without the IMU. Off: it
-  // did not keep the early losses from happening (same section).
+  // at the frame's time (eq. 25's rotation, gyro bias 0), its translation as without the IMU. Off by
+  // default: alone it did not keep the early losses from happening (same section); rs_vio.json turns it
+  // on with twist_gyro_sigma_before_init_rad_s, which does.
   bool frame_rotation_from_gyro_before_init = false;
   // Rolling shutter: the monocular start's rotation rate of each of its two images from the gyroscope
   // at the image's time (gyro bias 0) instead of fitted from the corner tracks
