@@ -51,7 +51,8 @@ struct InertialOptions {
   // Rolling shutter, before the initialisation: each keyframe's twist energy with its rotation rows
   // alone (the gyroscope at the keyframe's time, gyro bias 0: r = -R_Cm_I w_meas - xi_rot), with this
   // sigma [rad/s] for the gyroscope's noise and the bias not estimated yet; the smooth-motion prior's
-  // rotation rows on those keyframes weigh smooth_motion_rot_weight_before_init. 0: off.
+  // rotation rows on those keyframes weigh smooth_motion_rot_weight_before_init (they keep that weight
+  // after the initialisation, where the full twist energy holds their rotation). 0: off.
   double twist_gyro_sigma_before_init_rad_s = 0.0;
   double smooth_motion_rot_weight_before_init = 1.0;
   // Visual-inertial initialisation (vi_init.h), tried at every new keyframe until it succeeds.
