@@ -94,7 +94,7 @@ bool gyroRotationCols(const Keyframe& j, const GlobalStates& g, const SE3d& T_cm
 bool twistRotationCols(const Keyframe& k, const SE3d& T_cm_i, const InertialTermOptions& o, const StateLayout& layout,
                        Vec3* r, Mat3* W, std::vector<Col>* cols) {
   if (!layout.rolling || !k.twist_energy || !(o.twist_gyro_sigma_before_init_rad_s > 0.0)) return false;
-  *r = -(T_cm_i.so3() * (k.gyro_at_t - k.state.bias_gyro)) - k.state.twist.tail<3>();
+  *r = imuTwistRotation(k.gyro_at_t, k.state.bias_gyro, T_cm_i) - k.state.twist.tail<3>();
   const double s = o.twist_gyro_sigma_before_init_rad_s;
   *W = (o.twist_weight / (s * s)) * Mat3::Identity();
   if (!cols) return true;

@@ -6,6 +6,10 @@
 
 namespace rsvio {
 
+Vec3 imuTwistRotation(const Vec3& gyro_meas, const Vec3& bias_gyro, const SE3d& T_cm_i) {
+  return -(T_cm_i.so3() * (gyro_meas - bias_gyro));
+}
+
 Vec6 imuTwistPrior(const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyro, const SE3d& T_cf_wf,
                    const RxSO3d& T_wm_wf, const SE3d& T_cm_i) {
   // Eqs. 22-23: the velocity rotated into the IMU frame through the camera's rotation.

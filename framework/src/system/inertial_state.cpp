@@ -72,7 +72,7 @@ std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
     // Before the initialisation, optionally: the twist energy's rotation rows (inertial_term.h), and
     // the gyroscope's rate as the twist's starting rotation.
     linkTwistEnergy(kf);
-    if (kf.twist_energy) kf.state.twist.tail<3>() = -(T_cm_i_.so3() * (kf.gyro_at_t - kf.state.bias_gyro));
+    if (kf.twist_energy) kf.state.twist.tail<3>() = imuTwistRotation(kf.gyro_at_t, kf.state.bias_gyro, T_cm_i_);
   }
   if (!newest) return "";
   if (!initialised_) {
@@ -334,7 +334,7 @@ bool InertialState::frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_
 bool InertialState::gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const {
   const int64_t t = t_ns + offsetNs();
   if (!buffer_.covers(t, t)) return false;
-  *w = -(T_cm_i_.so3() * (buffer_.interpolate(t).gyro_rad_s - bias_gyro));
+  *w = imuTwistRotation(buffer_.interpolate(t).gyro_rad_s, bias_gyro, T_cm_i_);
   return true;
 }
 

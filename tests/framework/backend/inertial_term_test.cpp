@@ -5,6 +5,8 @@
 // addTo puts a term back where it came from), and the steps of the bundle adjuster on the global block.
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <Eigen/Cholesky>
 
 #include "ba_test_window.h"
@@ -185,18 +187,62 @@ TEST(InertialTerm, NormalEquationsMatchNumericDifferencesGlobalShutter) { checkN
 TEST(InertialTerm, NormalEquationsMatchNumericDifferencesRollingShutter) { checkNormalEquations(true, false); }
 TEST(InertialTerm, NormalEquationsMatchNumericDifferencesWithTimeOffset) { checkNormalEquations(true, true); }
 
+// The window system of a before-the-initialisation term (layout without the inertial blocks) on the
+// rolling chain, checked against numeric differences of `whitened` block by block (poses and twists);
+// returned for the test's own checks. The same options with the term's sigma at 0 add nothing.
+struct BeforeInitSystem {
+  InertialChain c{true, false};
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b, r0;
+  double e = 0.0;
+  std::vector<Block> bl;  // pose k at 2k, twist k at 2k + 1
+};
+
+InertialChain beforeInitChain() {
+  InertialChain c(true, false);
+  c.layout.inertial = false;
+  return c;
+}
+
+void checkBeforeInitTerm(const InertialTermOptions& o, const InertialTermOptions& off,
+                         const std::function<Eigen::VectorXd(const InertialChain&)>& whitened, BeforeInitSystem* s) {
+  s->c = beforeInitChain();
+  const InertialChain& c = s->c;
+  const int dim = c.dim();
+  ASSERT_EQ(dim, 3 * c.layout.kfDim()) << "no inertial or global blocks before the initialisation";
+  const InertialTerm term(o, c.T_cm_i, &c.globals);
+  s->H = Eigen::MatrixXd::Zero(dim, dim);
+  s->b = Eigen::VectorXd::Zero(dim);
+  s->e = term.linearize(c.window, c.layout, s->H, s->b);
+  s->r0 = whitened(c);
+  EXPECT_GT(s->e, 0.0);
+  EXPECT_NEAR(s->e, s->r0.squaredNorm(), 1e-9 * std::max(1.0, s->e));
+  auto f = [&](const Eigen::VectorXd& dx) {
+    InertialChain copy = beforeInitChain();
+    copy.apply(dx);
+    return whitened(copy);
+  };
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(dim);
+  const Eigen::MatrixXd J = test::numericJacobian(f, x0, test::vectorPlus, dim, 1e-6);
+  s->bl.clear();
+  for (int k = 0; k < c.n(); ++k) {
+    s->bl.push_back({"pose" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kPose, 6});
+    s->bl.push_back({"twist" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kTwist, 6});
+  }
+  expectBlocksNear(s->H, s->b, J.transpose() * J, -J.transpose() * s->r0, s->bl);
+  const InertialTerm none(off, c.T_cm_i, &c.globals);
+  Eigen::MatrixXd H0 = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd b0 = Eigen::VectorXd::Zero(dim);
+  EXPECT_EQ(none.linearize(c.window, c.layout, H0, b0), 0.0) << "off";
+  EXPECT_EQ(H0.cwiseAbs().maxCoeff(), 0.0) << "off";
+}
+
 // Before the visual-inertial initialisation (layout without the inertial blocks), with the gyroscope's
 // rotations on: each factor's rotation residual on the two poses, weight imu_weight (Cov_RR + (sigma_bg
 // dt)^2 I)^-1 (inertial_term.h). The normal equations against numeric differences of the whitened
 // rotation residuals, block by block; off (sigma 0) the term adds nothing. Shown once: the Jacobian of
 // each factor's first pose negated fails b of poses 0 and 1 and H between consecutive poses.
 TEST(InertialTerm, BeforeTheInitialisationTheGyroRotationsMatchNumericDifferences) {
-  auto makeChain = [] {
-    InertialChain c(true, false);
-    c.layout.inertial = false;
-    return c;
-  };
-  InertialChain c = makeChain();
   InertialTermOptions o;
   o.imu_weight = 0.7;
   o.gyro_bias_sigma_before_init_rad_s = 0.01;
@@ -219,51 +265,24 @@ TEST(InertialTerm, BeforeTheInitialisationTheGyroRotationsMatchNumericDifference
     }
     return Eigen::VectorXd(Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size())));
   };
-  const int dim = c.dim();
-  ASSERT_EQ(dim, 3 * c.layout.kfDim()) << "no inertial or global blocks before the initialisation";
-  const InertialTerm term(o, c.T_cm_i, &c.globals);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
-  const double e = term.linearize(c.window, c.layout, H, b);
-  const Eigen::VectorXd r0 = whitenedRot(c);
-  ASSERT_EQ(r0.size(), 6);
-  EXPECT_GT(e, 0.0);
-  EXPECT_NEAR(e, r0.squaredNorm(), 1e-9 * std::max(1.0, e));
-  auto f = [&](const Eigen::VectorXd& dx) {
-    InertialChain copy = makeChain();
-    copy.apply(dx);
-    return whitenedRot(copy);
-  };
-  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(dim);
-  const Eigen::MatrixXd J = test::numericJacobian(f, x0, test::vectorPlus, dim, 1e-6);
-  const Eigen::MatrixXd H_num = J.transpose() * J;
-  const Eigen::VectorXd b_num = -J.transpose() * r0;
-  std::vector<Block> bl;
-  for (int k = 0; k < c.n(); ++k) {
-    bl.push_back({"pose" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kPose, 6});
-    bl.push_back({"twist" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kTwist, 6});
-  }
-  expectBlocksNear(H, b, H_num, b_num, bl);
-  for (int k = 0; k < c.n(); ++k)
-    EXPECT_GT(H.block(bl[2 * k].offset + 3, bl[2 * k].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
+  InertialTermOptions off = o;
+  off.gyro_bias_sigma_before_init_rad_s = 0.0;
+  BeforeInitSystem s;
+  checkBeforeInitTerm(o, off, whitenedRot, &s);
+  ASSERT_EQ(s.r0.size(), 6);
+  for (int k = 0; k < s.c.n(); ++k)
+    EXPECT_GT(s.H.block(s.bl[2 * k].offset + 3, s.bl[2 * k].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
         << "rotation of pose " << k;  // (upsilon; omega): the rotation is the second half
 
   // Marginalising keyframe 1 takes both factors through it, on the three poses.
+  const InertialTerm term(o, s.c.T_cm_i, &s.c.globals);
   std::vector<Keyframe*> kfs;
   Eigen::MatrixXd Hm;
   Eigen::VectorXd bm;
-  const double em = term.linearizeInvolving(*c.window[1], c.window, c.layout, &kfs, &Hm, &bm);
+  const double em = term.linearizeInvolving(*s.c.window[1], s.c.window, s.c.layout, &kfs, &Hm, &bm);
   EXPECT_EQ(kfs.size(), 3u);
-  EXPECT_NEAR(em, e, 1e-9 * std::max(1.0, e));
-  EXPECT_LT((Hm - H).cwiseAbs().maxCoeff(), 1e-9 * H.cwiseAbs().maxCoeff());
-
-  // Off: nothing.
-  o.gyro_bias_sigma_before_init_rad_s = 0.0;
-  const InertialTerm off(o, c.T_cm_i, &c.globals);
-  Eigen::MatrixXd H0 = Eigen::MatrixXd::Zero(dim, dim);
-  Eigen::VectorXd b0 = Eigen::VectorXd::Zero(dim);
-  EXPECT_EQ(off.linearize(c.window, c.layout, H0, b0), 0.0);
-  EXPECT_EQ(H0.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(em, s.e, 1e-9 * std::max(1.0, s.e));
+  EXPECT_LT((Hm - s.H).cwiseAbs().maxCoeff(), 1e-9 * s.H.cwiseAbs().maxCoeff());
 }
 
 // Before the initialisation with imu.twist_gyro_sigma_before_init_rad_s: each keyframe's twist rotation
@@ -271,12 +290,6 @@ TEST(InertialTerm, BeforeTheInitialisationTheGyroRotationsMatchNumericDifference
 // pose, scale or gravity), weight twist_weight / sigma^2; numeric differences per block, the terms
 // through a keyframe for the marginalisation, and nothing when off.
 TEST(InertialTerm, BeforeTheInitialisationTheTwistRotationsFollowTheGyroscope) {
-  auto makeChain = [] {
-    InertialChain c(true, false);
-    c.layout.inertial = false;
-    return c;
-  };
-  InertialChain c = makeChain();
   InertialTermOptions o;
   o.twist_weight = 0.6;
   o.twist_gyro_sigma_before_init_rad_s = 0.03;
@@ -290,51 +303,26 @@ TEST(InertialTerm, BeforeTheInitialisationTheTwistRotationsFollowTheGyroscope) {
     }
     return Eigen::VectorXd(Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size())));
   };
-  const int dim = c.dim();
-  const InertialTerm term(o, c.T_cm_i, &c.globals);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
-  const double e = term.linearize(c.window, c.layout, H, b);
-  const Eigen::VectorXd r0 = whitenedTwistRot(c);
-  ASSERT_EQ(r0.size(), 9);
-  EXPECT_GT(e, 0.0);
-  EXPECT_NEAR(e, r0.squaredNorm(), 1e-9 * std::max(1.0, e));
-  auto f = [&](const Eigen::VectorXd& dx) {
-    InertialChain copy = makeChain();
-    copy.apply(dx);
-    return whitenedTwistRot(copy);
-  };
-  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(dim);
-  const Eigen::MatrixXd J = test::numericJacobian(f, x0, test::vectorPlus, dim, 1e-6);
-  const Eigen::MatrixXd H_num = J.transpose() * J;
-  const Eigen::VectorXd b_num = -J.transpose() * r0;
-  std::vector<Block> bl;
-  for (int k = 0; k < c.n(); ++k) {
-    bl.push_back({"pose" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kPose, 6});
-    bl.push_back({"twist" + std::to_string(k), c.layout.photometricOffset(k) + StateLayout::kTwist, 6});
-  }
-  expectBlocksNear(H, b, H_num, b_num, bl);
-  for (int k = 0; k < c.n(); ++k)
-    EXPECT_GT(H.block(bl[2 * k + 1].offset + 3, bl[2 * k + 1].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
+  InertialTermOptions off = o;
+  off.twist_gyro_sigma_before_init_rad_s = 0.0;
+  BeforeInitSystem s;
+  checkBeforeInitTerm(o, off, whitenedTwistRot, &s);
+  ASSERT_EQ(s.r0.size(), 9);
+  for (int k = 0; k < s.c.n(); ++k)
+    EXPECT_GT(s.H.block(s.bl[2 * k + 1].offset + 3, s.bl[2 * k + 1].offset + 3, 3, 3).diagonal().minCoeff(), 0.0)
         << "twist rotation of keyframe " << k;
 
   // Marginalising keyframe 1 takes its own twist term only (one keyframe).
+  const InertialTerm term(o, s.c.T_cm_i, &s.c.globals);
   std::vector<Keyframe*> kfs;
   Eigen::MatrixXd Hm;
   Eigen::VectorXd bm;
-  const double em = term.linearizeInvolving(*c.window[1], c.window, c.layout, &kfs, &Hm, &bm);
+  const double em = term.linearizeInvolving(*s.c.window[1], s.c.window, s.c.layout, &kfs, &Hm, &bm);
   ASSERT_EQ(kfs.size(), 1u);
-  EXPECT_NEAR(em, r0.segment<3>(3).squaredNorm(), 1e-9 * std::max(1.0, em));
-  const int o1 = c.layout.photometricOffset(1), kd = c.layout.kfDim();
-  EXPECT_LT((Hm.topLeftCorner(kd, kd) - H.block(o1, o1, kd, kd)).cwiseAbs().maxCoeff(), 1e-9 * H.cwiseAbs().maxCoeff());
-
-  // Off: nothing.
-  o.twist_gyro_sigma_before_init_rad_s = 0.0;
-  const InertialTerm off(o, c.T_cm_i, &c.globals);
-  Eigen::MatrixXd H0 = Eigen::MatrixXd::Zero(dim, dim);
-  Eigen::VectorXd b0 = Eigen::VectorXd::Zero(dim);
-  EXPECT_EQ(off.linearize(c.window, c.layout, H0, b0), 0.0);
-  EXPECT_EQ(H0.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(em, s.r0.segment<3>(3).squaredNorm(), 1e-9 * std::max(1.0, em));
+  const int o1 = s.c.layout.photometricOffset(1), kd = s.c.layout.kfDim();
+  EXPECT_LT((Hm.topLeftCorner(kd, kd) - s.H.block(o1, o1, kd, kd)).cwiseAbs().maxCoeff(),
+            1e-9 * s.H.cwiseAbs().maxCoeff());
 }
 
 // The terms that involve a keyframe, as the marginalisation takes them: keyframe 1's own factor and

@@ -32,6 +32,11 @@ struct TwistPriorJacobians {
   Eigen::Matrix<double, 6, 6> d_res_d_twist = -Eigen::Matrix<double, 6, 6>::Identity();
 };
 
+// Eq. 25's rotation: the camera's rotation rate from the gyroscope, -R_Cm_I (w - b_g) (rad/s, the
+// rotation part of a twist left of T_Cf_Wf). It is also eq. 32's rotation, which needs no pose,
+// velocity, scale or gravity, so it serves before the visual-inertial initialisation.
+Vec3 imuTwistRotation(const Vec3& gyro_meas, const Vec3& bias_gyro, const SE3d& T_cm_i);
+
 // Eq. 32: the IMU's prediction of the keyframe's camera twist in W_f units per second.
 Vec6 imuTwistPrior(const Vec3& gyro_meas, const Vec3& v_wm, const Vec3& bias_gyro, const SE3d& T_cf_wf,
                    const RxSO3d& T_wm_wf, const SE3d& T_cm_i);
