@@ -12,8 +12,12 @@
 //   T_Wm_Wf = (scale, rotation of T_wm_wf) and T_Cm_I) is propagated with the preintegrated IMU at the
 //   state's biases (eqs. 13-15) and mapped back to T_Cf_Wf. Without an inertial state (before the
 //   visual-inertial initialisation) or without IMU coverage it falls back to constant velocity from
-//   the last two frames (one frame: its pose). With `recovery`, the constant-velocity guess (when the
-//   IMU guess came first) and "no motion" follow as further guesses.
+//   the last two frames (one frame: its pose). Before the initialisation, with `gyro_rotation_guess`
+//   and IMU coverage, the first guess is that constant-velocity guess's camera centre with the
+//   rotation the gyroscope integrates from the last frame (bias 0: it is not estimated yet):
+//       R_Wf_C(t) = R_Wf_C(t_last) R_C_I dR_I(t_last -> t) R_I_C.
+//   With `recovery`, the constant-velocity guess (when an IMU guess came first) and "no motion" follow
+//   as further guesses.
 // - twistPrior(history, keyframe): needs keyframe.has_inertial and IMU data at the keyframe's time;
 //   mean = eq. 32 from the gyroscope reading interpolated at the keyframe's time, the keyframe's
 //   velocity, gyro bias, pose and scale-gravity transform; information diagonal (the paper's manually
@@ -42,6 +46,10 @@ struct ImuMotionOptions {
   double buffer_s = 20.0;                // IMU history kept (covers the keyframe window's twist priors)
   double max_extrapolation_ms = 5.0;     // a camera stamp this far past the last IMU sample holds it
   bool recovery = true;                  // append constant-velocity and no-motion guesses
+  // Before the visual-inertial initialisation: the first guess's rotation from the gyroscope (the
+  // constant-velocity guess's rotation is 1-3.5 deg off at the Table I motions' 500 deg/s^2). Off: it
+  // prevented none of rs_vio's early losses there (docs/vio.md, 2026-12-05).
+  bool gyro_rotation_guess = false;
   // The window's smooth-motion prior on the rolling-shutter twists (backend/smooth_motion_term.h, as
   // motion.constant_velocity's twist_info_*), non-metric: per (W_f unit / s)^2 and (s / rad)^2. It holds
   // the twists before the visual-inertial initialisation, when the IMU twist energy has no scale yet,
@@ -73,7 +81,8 @@ class ImuMotionPrior : public MotionPrior {
     const MotionState& last = history.back();
     const SE3d cv = constantVelocityGuess(history, t_ns);
     SE3d imu_guess;
-    const bool have_imu_guess = imuGuess(last, t_ns, &imu_guess);
+    const bool have_imu_guess = imuGuess(last, t_ns, &imu_guess) ||
+                                (o_.gyro_rotation_guess && !last.has_inertial && gyroGuess(last, cv, t_ns, &imu_guess));
     if (have_imu_guess) out.push_back(imu_guess);
     out.push_back(cv);
     if (!o_.recovery) return {out.front()};
@@ -143,6 +152,19 @@ class ImuMotionPrior : public MotionPrior {
     ImuState s;
     if (!predictState(last, t_ns, &s)) return false;
     *guess = cameraPoseFromImu(SE3d(s.R_w_i, s.p_w_i), metricFromFree(last), T_cm_i_);
+    return true;
+  }
+
+  // Before the initialisation: cv's camera centre, the rotation integrated by the gyroscope from the
+  // last frame with a zero bias (contract above).
+  bool gyroGuess(const MotionState& last, const SE3d& cv, int64_t t_ns, SE3d* guess) const {
+    if (!has_imu_ || t_ns <= last.t_ns) return false;
+    const int64_t off = sToNs(time_offset_s_);
+    if (!buffer_.covers(last.t_ns + off, t_ns + off)) return false;
+    const SO3d dR = ImuPreintegration::fromBuffer(buffer_, last.t_ns, t_ns, noise_, ImuBias{}, time_offset_s_).deltaR();
+    const SO3d R_ci = T_cm_i_.so3();
+    const SO3d R_w_c = last.T_c_w.so3().inverse() * R_ci * dR * R_ci.inverse();
+    *guess = SE3d(R_w_c, cv.inverse().translation()).inverse();
     return true;
   }
 

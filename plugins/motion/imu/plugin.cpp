@@ -18,6 +18,9 @@ ParamTable table() {
       paramDouble("max_extrapolation_ms", d.max_extrapolation_ms, 0.0, 100.0, "ms",
                   "a camera time this far past the last IMU sample uses that sample"),
       paramBool("recovery", d.recovery, "append the constant-velocity and no-motion guesses after the IMU's"),
+      paramBool("gyro_rotation_guess", d.gyro_rotation_guess,
+                "before the visual-inertial initialisation: the first guess's rotation from the gyroscope, its "
+                "translation from constant velocity"),
       paramDouble("smooth_twist_info_trans", d.smooth_twist_info_trans, 0.0, 1e12, "s^2/unit^2",
                   "information of the window's smooth-motion prior on rolling-shutter twists, translation (0: none)"),
       paramDouble("smooth_twist_info_rot", d.smooth_twist_info_rot, 0.0, 1e12, "s^2/rad^2",
@@ -36,6 +39,7 @@ void registerAll(PluginRegistrar& r) {
                        o.buffer_s = p.getDouble("buffer_s");
                        o.max_extrapolation_ms = p.getDouble("max_extrapolation_ms");
                        o.recovery = p.getBool("recovery");
+                       o.gyro_rotation_guess = p.getBool("gyro_rotation_guess");
                        o.smooth_twist_info_trans = p.getDouble("smooth_twist_info_trans");
                        o.smooth_twist_info_rot = p.getDouble("smooth_twist_info_rot");
                        return std::make_unique<ImuMotionPrior>(o);

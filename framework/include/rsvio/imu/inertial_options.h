@@ -38,7 +38,10 @@ struct InertialOptions {
   bool init_rates_from_gyro = false;
   // Rolling shutter: the weight of the smooth-motion twist prior (backend/smooth_motion_term.h) of a
   // keyframe that has the IMU twist energy (made after the initialisation); 1: as before it. Lighter
-  // weights lost track or were less accurate (docs/vio.md, same section).
+  // weights lost track or were less accurate with motion.imu's default Sigma (0.02 rad/s, 0.1 m/s;
+  // docs/vio.md, same section); rs_vio.json sets 0 with that Sigma at 0.002 rad/s and 0.02 m/s, so
+  // that the twist energy holds the twists as in the paper (docs/vio.md, "The gyroscope holds the
+  // twists all through").
   double smooth_motion_weight = 1.0;
   // Before the initialisation: the gyroscope's relative rotation between consecutive keyframes as a
   // window term on their poses (backend/inertial_term.h), with this sigma for the bias that is not
