@@ -72,9 +72,7 @@ TEST(ImuMotionPrior, PredictsTheNextFramePoseFromTheImu) {
 
 TEST(ImuMotionPrior, FallsBackToConstantVelocityWithoutInertialState) {
   World w;
-  ImuMotionOptions opt;
-  opt.gyro_rotation_guess = false;
-  ImuMotionPrior p(opt);
+  ImuMotionPrior p;  // gyro_rotation_guess off (the default)
   p.setSensors(w.sensors);
   w.feed(p, 0.0, 2.0);
   const std::vector<MotionState> h = {w.state(0.95, false), w.state(1.0, false)};
