@@ -17,7 +17,9 @@
 #              and only their first DURATION_S seconds: --set motion.duration_s=DURATION_S)
 #   DURATION_S the seconds simulated of the seqNN sequences (default 15, issue 14's acceptance)
 #   MODES      the runs per seed (default "rsvio_rs gsvio_rs gsvio_gs"); rsviodm_rs and gsviodm_gs are
-#              rs_vio on RS and gs_vio on the twin with imu.dynamic_marginalization=true
+#              rs_vio on RS and gs_vio on the twin with imu.dynamic_marginalization=true; rsvio_gs is
+#              rs_vio on the GS twin with a near-zero line delay (0.001 us): the rolling-shutter settings
+#              without a readout, which separates what the readout costs from what the settings cost
 #   SETS       more --set lines for every run, e.g. SETS="imu.init_scale_factor=1.3"
 #   TAG        appended to the run folders (run_<seq>_s<seed>_<mode><TAG>), to keep variants apart
 # Datasets are simulated once into OUT_DIR/<seq>_<rs|gs>_s<seed> and reused (0.5-3 min each on 2
@@ -59,6 +61,7 @@ run_one() {  # seq seed mode
     rsvio_rs) cfg=configs/rs_vio.json; data="$OUT/${seq}_rs_s$seed"; sets=(--set shutter.params.line_delay_us=58.94) ;;
     gsvio_rs) cfg=configs/gs_vio.json; data="$OUT/${seq}_rs_s$seed" ;;
     gsvio_gs) cfg=configs/gs_vio.json; data="$OUT/${seq}_gs_s$seed" ;;
+    rsvio_gs) cfg=configs/rs_vio.json; data="$OUT/${seq}_gs_s$seed"; sets=(--set shutter.params.line_delay_us=0.001) ;;
     rsviodm_rs) cfg=configs/rs_vio.json; data="$OUT/${seq}_rs_s$seed"
                 sets=(--set shutter.params.line_delay_us=58.94 --set imu.dynamic_marginalization=true) ;;
     gsviodm_gs) cfg=configs/gs_vio.json; data="$OUT/${seq}_gs_s$seed"; sets=(--set imu.dynamic_marginalization=true) ;;

@@ -156,8 +156,10 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
     pw.idepth[k] = p.idepth;
   }
   const bool rolling = cfg.layout.rolling;
-  RsFrame host{pw.host->state.T_c_w, rolling ? pw.host->state.twist : Vec6::Zero()};
-  RsFrame target{pw.target->state.T_c_w, rolling ? pw.target->state.twist : Vec6::Zero()};
+  RsFrame host{pw.host->state.T_c_w, rolling ? pw.host->state.twist : Vec6::Zero(),
+               rolling ? pw.host->w_dot : Vec3::Zero()};
+  RsFrame target{pw.target->state.T_c_w, rolling ? pw.target->state.twist : Vec6::Zero(),
+                 rolling ? pw.target->w_dot : Vec3::Zero()};
   if (rolling) {
     pw.host_pts.resize(static_cast<size_t>(n));
     for (int k = 0; k < n; ++k)
@@ -470,7 +472,7 @@ void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundle
         if (!(p.idepth > 0.0) || !std::isfinite(p.idepth)) continue;  // projectRollingShutter skips it
         const Keyframe& h = *p.host;
         m.host_points[static_cast<size_t>(i)] = rsHostPoint(ex[static_cast<size_t>(h.index)], h.state.twist,
-                                                            m.timing.rowTime(p.v), p.bearing, p.idepth, true);
+                                                            m.timing.rowTime(p.v), p.bearing, p.idepth, true, h.w_dot);
       }
     });
   }

@@ -80,7 +80,7 @@ struct Work {
   Vec2 best_uv, dir;
 };
 
-SE3d poseAt(const RsFrame& f, double t) { return t == 0.0 ? f.T_c_w0 : SE3d::exp(f.xi * t) * f.T_c_w0; }
+SE3d poseAt(const RsFrame& f, double t) { return rsPoseAt(f, t); }
 
 // rho with Rb + rho t parallel to the bearing d (closest point on the host ray, in the target frame).
 double rhoForBearing(const Vec3& d, const Vec3& Rb, const Vec3& t) {

@@ -71,7 +71,8 @@ void FrameTracker::setReference(const TrackingReference& reference) {
       // Fixed in the world at the host row's capture time (eq. 6 at t(v_h), eq. 7).
       const double t_h = timing_.rowTime(uv0[i].y());
       const Vec3 Z_c = bearing.col(static_cast<Eigen::Index>(i)) / idepth[i];
-      const Vec3 Z = t_h == 0.0 ? Z_c : ref_exp.apply(-t_h, Z_c);
+      // With w_dot: T_h(t_h) = A(t_h) exp(xi t_h) T_h0, so Z = exp(-xi t_h) A^T Z_c.
+      const Vec3 Z = t_h == 0.0 ? Z_c : ref_exp.apply(-t_h, ReadoutRotation(ref_.w_dot, t_h).A.transpose() * Z_c);
       X.push_back(T_w_h0 * Z);
       L->host.push_back(host);
       L->host_uv0.push_back(uv0[i]);
@@ -119,6 +120,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
   }
   const Vec3 xi_v = target.xi.head<3>(), xi_w = target.xi.tail<3>();
   const TwistExp ex(target.xi);
+  const bool acc = !target.w_dot.isZero(0.0);  // RsFrame::w_dot: P = A(t) exp(xi t) P0
   if (B.row.size() != static_cast<size_t>(n)) B.row.assign(static_cast<size_t>(n), timing_.y0);
   B.uv.resize(2, n);
   B.valid.assign(static_cast<size_t>(n), 0);
@@ -131,6 +133,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       const int i = B.active[static_cast<size_t>(k)];
       const double ti = timing_.rowTime(B.row[static_cast<size_t>(i)]);
       B.P.col(k) = ex.apply(ti, Vec3(B.P0.col(i)));  // eq. 6 at the row's time (eq. 7)
+      if (acc) B.P.col(k) = ReadoutRotation(target.w_dot, ti).A * B.P.col(k);
     }
     camera_.project(B.P, B.uv_a, B.valid_a, &B.J);
     B.still.clear();
@@ -140,7 +143,12 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       if (!B.valid_a[static_cast<size_t>(k)]) continue;
       const Jac23& J = B.J[static_cast<size_t>(k)];
       const Vec3 Pk = B.P.col(k);
-      const Vec2 a = J * (xi_v + xi_w.cross(Pk)) * c;
+      ReadoutRotation rr;
+      if (acc) rr = ReadoutRotation(target.w_dot, timing_.rowTime(B.row[si]));
+      // d P / d t: xi^ P, or with w_dot g x P + A (xi_v + xi_w x A^T P)
+      const Vec3 dPdt = acc ? Vec3(rr.g.cross(Pk) + rr.A * (xi_v + xi_w.cross(rr.A.transpose() * Pk)))
+                            : Vec3(xi_v + xi_w.cross(Pk));
+      const Vec2 a = J * dPdt * c;
       const double denom = 1.0 - a.y();
       if (std::abs(denom) < 1e-3) continue;  // no unique row
       const double res = B.uv_a(1, k) - B.row[si];
@@ -158,7 +166,8 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       B.uv.col(i) = B.uv_a.col(k) + a * step;
       B.valid[si] = 1;
       if (linearize) {
-        Mat26 D = J * ex.rotation(ti) * dLeftAction(B.P0.col(i));
+        Mat26 D = acc ? Mat26(J * (rr.A * ex.rotation(ti)) * dLeftAction(B.P0.col(i)))
+                      : Mat26(J * ex.rotation(ti) * dLeftAction(B.P0.col(i)));
         const double inv = 1.0 / denom;
         D.row(0) += (a.x() * inv) * D.row(1);
         D.row(1) *= inv;
@@ -267,7 +276,7 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
 
 void FrameTracker::projectReference(int level, const SE3d& T_c_w, const Vec6& twist, Eigen::Matrix2Xd* uv,
                                     std::vector<uint8_t>* valid, std::vector<Eigen::Matrix<double, 2, 6>>* d_uv_d_T,
-                                    Eigen::Matrix3Xd* X_w) const {
+                                    Eigen::Matrix3Xd* X_w, const Vec3& w_dot) const {
   if (!hasReference()) throw Error("FrameTracker::projectReference: no reference keyframe");
   LevelPoints& L = *levels_.at(static_cast<size_t>(level));
   resetRows();
@@ -276,7 +285,7 @@ void FrameTracker::projectReference(int level, const SE3d& T_c_w, const Vec6& tw
   valid->assign(static_cast<size_t>(L.n), 0);
   if (d_uv_d_T) d_uv_d_T->assign(static_cast<size_t>(L.n), Mat26::Zero());
   for (Block& B : L.blocks) {
-    projectBlock(B, RsFrame{T_c_w, twist}, d_uv_d_T != nullptr);
+    projectBlock(B, RsFrame{T_c_w, twist, w_dot}, d_uv_d_T != nullptr);
     for (Eigen::Index i = 0; i < B.X_w.cols(); ++i) {
       const size_t j = static_cast<size_t>(B.begin + i);
       if (X_w) X_w->col(static_cast<Eigen::Index>(j)) = B.X_w.col(i);
@@ -292,7 +301,7 @@ FrameTracker::LevelEnergy FrameTracker::levelEnergy(const ImagePyramid& frame, c
   if (!hasReference()) throw Error("FrameTracker::levelEnergy: no reference keyframe");
   Linearization lin;
   resetRows();
-  RsFrame target{T_c_w, info.twist};
+  RsFrame target{T_c_w, info.twist, info.w_dot};
   evaluate(frame.level(level), level, target, affine, exposureRatio(ref_.exposure_ms, info.exposure_ms),
            options_.cutoff_th, false, lin);
   LevelEnergy e;

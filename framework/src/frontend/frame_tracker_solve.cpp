@@ -45,10 +45,10 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
   for (int lvl = coarsest; lvl >= 0; --lvl) {
     const ImageLevel& img = frame.level(lvl);
     double cutoff_mult = 1.0;
-    evaluate(img, lvl, RsFrame{a.T_c_w, info.twist}, a.affine, exposure_ratio, options_.cutoff_th, true, lin);
+    evaluate(img, lvl, RsFrame{a.T_c_w, info.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th, true, lin);
     while (lin.saturatedRatio() > 0.6 && cutoff_mult < 50.0) {
       cutoff_mult *= 2.0;
-      evaluate(img, lvl, RsFrame{a.T_c_w, info.twist}, a.affine, exposure_ratio, options_.cutoff_th * cutoff_mult,
+      evaluate(img, lvl, RsFrame{a.T_c_w, info.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th * cutoff_mult,
                true, lin);
     }
     if (lin.num_points == 0) {
@@ -82,7 +82,7 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
       AffineBrightness aff_new = a.affine;
       aff_new.a += inc(6);
       aff_new.b += inc(7);
-      evaluate(img, lvl, RsFrame{T_new, info.twist}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
+      evaluate(img, lvl, RsFrame{T_new, info.twist, info.w_dot}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
                lin_new);
       ++a.iterations;
       const bool accept = lin_new.num_terms > 0 && lin_new.meanEnergy() < lin.meanEnergy();

@@ -61,8 +61,12 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
   const Vec3 xi_w = target.xi.tail<3>();
 
   const TwistExp ex(target.xi);
+  const bool acc = !target.w_dot.isZero(0.0);  // the rows' second-order rotation (RsFrame::w_dot)
   std::vector<Vec3> P0(n), P(n);
-  std::vector<Mat3> E(n);  // rotation of exp(xi t) at the current row
+  std::vector<Mat3> E(n);  // rotation of exp(xi t) at the current row (times A(t) with w_dot)
+  std::vector<Vec3> dPdt(n);  // d P / d t at the current row, fixed state
+  std::vector<Mat3> A(acc ? n : 0);  // ReadoutRotation's A at the current row
+  std::vector<Vec3> Pxi(acc ? n : 0);  // exp(xi t) P0, before A
   std::vector<Jac23> Jc(n);
   std::vector<Vec2> a(n, Vec2::Zero());
   std::vector<double> v(n, timing.y0);  // start at t = 0: the first evaluation is the global-shutter pixel
@@ -83,8 +87,18 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     for (size_t k = 0; k < active.size(); ++k) {
       const size_t i = active[k];
       Vec3 p;
-      ex.at(timing.rowTime(v[i]), E[i], p);  // eq. 6 at the row's time (eq. 7)
+      const double t = timing.rowTime(v[i]);
+      ex.at(t, E[i], p);  // eq. 6 at the row's time (eq. 7)
       P[i] = E[i] * P0[i] + p;
+      dPdt[i] = xi_v + xi_w.cross(P[i]);  // d/dt exp(xi t) = xi^ exp(xi t)
+      if (acc) {  // P = A(t) exp(xi t) P0: d P / d t = g x P + A (xi_v + xi_w x exp(xi t) P0)
+        const ReadoutRotation rr(target.w_dot, t);
+        A[i] = rr.A;
+        Pxi[i] = P[i];
+        P[i] = rr.A * Pxi[i];
+        E[i] = rr.A * E[i];
+        dPdt[i] = rr.g.cross(P[i]) + rr.A * dPdt[i];
+      }
       Pa.col(static_cast<Eigen::Index>(k)) = P[i];
     }
     camera.project(Pa, uva, va, need_J ? &Ja : nullptr);  // one batch call per iteration
@@ -98,7 +112,7 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
       if (!va[k]) continue;  // behind the camera or outside its domain: stays invalid
       if (need_J) {
         Jc[i] = Ja[k];
-        a[i] = Jc[i] * (xi_v + xi_w.cross(P[i])) * c;  // d project / d v at fixed state
+        a[i] = Jc[i] * dPdt[i] * c;  // d project / d v at fixed state
       }
       const double res = r.uv.y() - v[i];
       if (c == 0.0 || std::abs(res) <= opt.tolerance_px) {
@@ -122,14 +136,16 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     const Eigen::Matrix<double, 2, 3> JR = Jc[i] * E[i];
     // Partial derivatives at a fixed row, then M for the row's own dependence on the state.
     r.d_uv_d_T0 = JR * dLeftAction(P0[i]);
-    if (t != 0.0)
-      r.d_uv_d_xi = Jc[i] * dLeftActionTimesJl(P[i], target.xi * t) * t;
-    else
+    if (t == 0.0)
       r.d_uv_d_xi.setZero();
+    else if (acc)
+      r.d_uv_d_xi = (Jc[i] * A[i]) * dLeftActionTimesJl(Pxi[i], target.xi * t) * t;
+    else
+      r.d_uv_d_xi = Jc[i] * dLeftActionTimesJl(P[i], target.xi * t) * t;
     r.d_uv_d_X = JR * target.T_c_w0.rotationMatrix();
     // The row of the solution is uv.y (equal to the iterate within tolerance; for a global shutter the
     // iterate stays at y0 while the pixel's row is uv.y).
-    r.d_uv_d_line_delay = Jc[i] * (xi_v + xi_w.cross(P[i])) * timing.dRowTimeDLineDelay(r.uv.y());
+    r.d_uv_d_line_delay = Jc[i] * dPdt[i] * timing.dRowTimeDLineDelay(r.uv.y());
     applyImplicitRow(r.d_uv_d_T0, a[i]);
     applyImplicitRow(r.d_uv_d_xi, a[i]);
     applyImplicitRow(r.d_uv_d_X, a[i]);
@@ -149,10 +165,16 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
 }
 
 RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, const Vec3& bearing_h, double rho,
-                        bool jacobians) {
+                        bool jacobians, const Vec3& w_dot_h) {
   RsHostPoint h;
   Vec3 p;
   ex_h.at(-t_h, h.E, p);  // exp(xi_h (-t_h))
+  if (!w_dot_h.isZero(0.0) && t_h != 0.0) {  // T_h_w(t_h) = A_h exp(xi_h t_h) T_h_w0: undo A_h first
+    const ReadoutRotation rr(w_dot_h, t_h);
+    h.E = h.E * rr.A.transpose();
+    // d (A^T y) / d t = -A^T (g x y), y = b / rho
+    if (jacobians) h.dZ_dt_acc = -h.E * rr.g.cross(Vec3(bearing_h / rho));
+  }
   h.Z = h.E * Vec3(bearing_h / rho) + p;
   if (jacobians && t_h != 0.0) h.dZ = dLeftActionTimesJl(h.Z, -xi_h * t_h);
   return h;
@@ -192,7 +214,8 @@ void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const
     o.d_uv_d_xi_h.setZero();
     o.d_uv_d_idepth.setZero();
     if (!host_points)
-      computed[s] = rsHostPoint(ex_h, host.xi, timing.rowTime(v_h[i]), bearing_h.col(i), rho, options.jacobians);
+      computed[s] = rsHostPoint(ex_h, host.xi, timing.rowTime(v_h[i]), bearing_h.col(i), rho, options.jacobians,
+                                host.w_dot);
     X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * hp[s].Z;
     idx.push_back(i);
   }
@@ -218,8 +241,9 @@ void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const
     else
       r.d_uv_d_xi_h.setZero();
     r.d_uv_d_idepth = d_uv_d_Z * (h.E * Vec3(-bearing_h.col(i) / (rho * rho)));
-    // Host row time: d Z / d t_h = -(xi_v + xi_w x Z).
-    r.d_uv_d_line_delay += d_uv_d_Z * Vec3(-(xh_v + xh_w.cross(h.Z))) * timing.dRowTimeDLineDelay(v_h[i]);
+    // Host row time: d Z / d t_h = -(xi_v + xi_w x Z) (+ the w_dot part).
+    r.d_uv_d_line_delay +=
+        d_uv_d_Z * Vec3(h.dZ_dt_acc - (xh_v + xh_w.cross(h.Z))) * timing.dRowTimeDLineDelay(v_h[i]);
   }
 }
 

@@ -31,6 +31,9 @@ ParamTable inertialParamTable() {
       paramBool("init_rates_from_gyro", d.init_rates_from_gyro,
                 "rolling shutter: the monocular start's rotation rate of each image from the gyroscope at its time "
                 "(gyro bias 0) instead of from the corner tracks (backend.init_rotation_rates)"),
+      paramBool("readout_angular_acceleration", d.readout_angular_acceleration,
+                "rolling shutter: the rows' rotation to second order in the row time, with the twist rotation's rate of "
+                "change from the gyroscope (known, not optimised)"),
       paramDouble("smooth_motion_weight", d.smooth_motion_weight, 0.0, 1e6, "",
                   "rolling shutter: weight of the smooth-motion twist prior of keyframes that have the IMU twist "
                   "energy (after the initialisation); 1: the same as before it"),
@@ -103,6 +106,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.gyro_bias_sigma_before_init_rad_s = p.getDouble("gyro_bias_sigma_before_init_rad_s");
   o.frame_rotation_from_gyro_before_init = p.getBool("frame_rotation_from_gyro_before_init");
   o.init_rates_from_gyro = p.getBool("init_rates_from_gyro");
+  o.readout_angular_acceleration = p.getBool("readout_angular_acceleration");
   o.twist_gyro_sigma_before_init_rad_s = p.getDouble("twist_gyro_sigma_before_init_rad_s");
   o.smooth_motion_rot_weight_before_init = p.getDouble("smooth_motion_rot_weight_before_init");
   o.init_min_keyframes = static_cast<int>(p.getInt("init_min_keyframes"));

@@ -331,6 +331,15 @@ bool InertialState::frameTwist(const Keyframe& ref, int64_t t_ns, const SE3d& T_
                        ref.t_ns, t_ns, globals_.state.time_offset_s, T_c_w, globals_.state.T_wm_wf, T_cm_i_, xi);
 }
 
+Vec3 InertialState::readoutWDot(int64_t t_ns) const {
+  constexpr int64_t h = 10'000'000;  // 10 ms: two gyroscope samples at 200 Hz
+  const int64_t t = t_ns + offsetNs();
+  if (!rolling_ || !o_.readout_angular_acceleration || !buffer_.covers(t - h, t + h)) return Vec3::Zero();
+  const Vec3 w_minus = imuTwistRotation(buffer_.interpolate(t - h).gyro_rad_s, Vec3::Zero(), T_cm_i_);
+  const Vec3 w_plus = imuTwistRotation(buffer_.interpolate(t + h).gyro_rad_s, Vec3::Zero(), T_cm_i_);
+  return (w_plus - w_minus) / (2e-9 * static_cast<double>(h));
+}
+
 bool InertialState::gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const {
   const int64_t t = t_ns + offsetNs();
   if (!buffer_.covers(t, t)) return false;

@@ -85,6 +85,10 @@ class InertialState {
   // left of T_Cf_Wf: -R_Cm_I (gyro - b_g), rad/s) with the gyro bias b_g given. Needs no scale or
   // gravity, so it serves before the initialisation. False without an IMU sample around t_ns + offset.
   bool gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const;
+  // Rolling shutter with options().readout_angular_acceleration: RsFrame::w_dot at camera time t_ns, the
+  // rate of change of gyroRate (central difference over +-10 ms, the bias cancels). Zero otherwise or
+  // without IMU samples over that span.
+  Vec3 readoutWDot(int64_t t_ns) const;
 
   // The window term: after the initialisation, and before it with the gyroscope's rotations on.
   const WindowTerm* term() const { return initialised_ || termsBeforeInit() ? term_.get() : nullptr; }

@@ -15,7 +15,9 @@
 namespace rsvio {
 namespace {
 
-RsFrame rsFrame(const Keyframe& kf, bool rolling) { return RsFrame{kf.state.T_c_w, rolling ? kf.state.twist : Vec6::Zero()}; }
+RsFrame rsFrame(const Keyframe& kf, bool rolling) {
+  return rolling ? RsFrame{kf.state.T_c_w, kf.state.twist, kf.w_dot} : RsFrame{kf.state.T_c_w, Vec6::Zero()};
+}
 
 // Projects every active point of `host` into `target` (one batch, no Jacobians); proj[i] is points[i]'s.
 void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const Keyframe& host, const RsFrame& target,
@@ -38,9 +40,9 @@ void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const
 
 Vec3 pointInWorld(const ActivePoint& p, const RowTiming& timing, bool rolling) {
   const Keyframe& host = *p.host;
-  Vec3 Z = p.bearing / p.idepth;
-  if (rolling) Z = SE3d::exp(-host.state.twist * timing.rowTime(p.v)) * Z;
-  return host.state.T_c_w.inverse() * Z;
+  if (!rolling) return host.state.T_c_w.inverse() * Vec3(p.bearing / p.idepth);
+  return rsPoseAt(RsFrame{host.state.T_c_w, host.state.twist, host.w_dot}, timing.rowTime(p.v)).inverse() *
+         Vec3(p.bearing / p.idepth);
 }
 
 KeyframeWindow::KeyframeWindow(const WindowSetup& setup, const CameraModel& camera, const RowTiming& timing,
@@ -293,6 +295,7 @@ TrackingReference KeyframeWindow::trackingReference(const Keyframe& newest) cons
   ref.t_ns = newest.t_ns;
   ref.T_c_w = newest.state.T_c_w;
   ref.twist = rolling_ ? newest.state.twist : Vec6::Zero();
+  ref.w_dot = rolling_ ? newest.w_dot : Vec3::Zero();
   ref.affine = newest.state.affine;
   ref.exposure_ms = newest.exposure_ms;
   ref.pyramid = newest.pyramid;

@@ -142,6 +142,7 @@ void Odometry::Impl::tryInertialInitialisation() {
 // prior where the IMU measures its twist: the whole twist after the initialisation
 // (imu.smooth_motion_weight), the rotation alone before it (imu.smooth_motion_rot_weight_before_init).
 void Odometry::Impl::linkInertial(Keyframe& kf) {
+  kf.w_dot = inertial->readoutWDot(kf.t_ns);
   const std::string w = inertial->onNewKeyframe(kf, window->empty() ? nullptr : &window->newest());
   if (!w.empty()) record->addWarning(w);
   if (!kf.twist_energy) return;
@@ -195,6 +196,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
     const std::vector<SE3d> g = tracking->guesses(frame.t_ns);
     inertial->frameTwist(ref, frame.t_ns, g.empty() ? ref.state.T_c_w : g.front(), &info.twist);
   }
+  if (rolling && inertial) info.w_dot = inertial->readoutWDot(frame.t_ns);
   info.affine_guess = record->frames().empty() ? ref.state.affine : record->frames().back().affine;
   TrackResult r;
   bool ok = false;
@@ -222,6 +224,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
     CandidateFrame target;
     target.pose = RsFrame{r.T_c_w, rolling ? tracking->velocityEstimate() : Vec6::Zero()};
     if (imu_twist) inertial->frameTwist(ref, frame.t_ns, r.T_c_w, &target.pose.xi);
+    target.pose.w_dot = info.w_dot;
     target.affine = r.affine;
     target.exposure_ms = frame.exposure_ms;
     window->traceCandidates(target, pyr->level(0));
@@ -399,6 +402,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   CandidateFrame target;
   // The current frame's twist: its own (init_rotation_rates), else the two-view twist, or 0.
   target.pose = RsFrame{T_cur_ref, own_twists ? start->xiCur() : k0.state.twist};
+  if (rolling && inertial) target.pose.w_dot = inertial->readoutWDot(frame.t_ns);
   target.exposure_ms = frame.exposure_ms;
   window->traceCandidates(target, pyr->level(0));
   record->recordKeyframe(k0);
@@ -427,6 +431,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
     TrackingFrame info;
     info.t_ns = f.t_ns;
     info.exposure_ms = f.exposure_ms;
+    if (rolling && inertial) info.w_dot = inertial->readoutWDot(f.t_ns);
     const double s = span > 0 ? nsToS(f.t_ns - ref.t_ns) / span : 0.5;
     const TrackResult r = tracking->trackFrom(p, info, {SE3d::exp(log_rel * s)});
     if (!r.ok()) continue;

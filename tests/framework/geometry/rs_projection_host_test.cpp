@@ -40,6 +40,13 @@ class RsHostProjectionTest : public ::testing::Test {
     return o;
   }
 
+  static RsFrame withWDot(RsFrame f, const Vec3& w_dot) {
+    f.w_dot = w_dot;
+    return f;
+  }
+  // Angular accelerations of a violent turn (rad/s^2): at the outer rows (5 ms) about 0.3 mrad of rotation.
+  const Vec3 kHostWDot = Vec3(12.0, -20.0, 6.0), kTargetWDot = Vec3(-9.0, 15.0, 25.0);
+
   std::unique_ptr<CameraModel> cam_;
   RowTiming timing_;
   RsFrame target_, host_;
@@ -50,19 +57,28 @@ TEST_F(RsHostProjectionTest, EqualsTheWorldPointForm) {
   double v_h;
   hostPoint(Vec2(70.0, 200.0), b, v_h);
   const double rho = 0.4;
-  const RsHostProjection r = projectRollingShutter(*cam_, timing_, host_, target_, b, v_h, rho);
-  // The host saw the point at its row's time: X = T_h_w(t_h)^-1 (b / rho).
-  const SE3d T_h_w = SE3d::exp(host_.xi * timing_.rowTime(v_h)) * host_.T_c_w0;
-  const Vec3 X = T_h_w.inverse() * Vec3(b / rho);
-  const RsProjection w = projectRollingShutter(*cam_, timing_, target_, X);
-  ASSERT_TRUE(r.valid);
-  EXPECT_LT((r.uv - w.uv).norm(), 1e-9);
-  EXPECT_JACOBIAN_NEAR(r.d_uv_d_T0, w.d_uv_d_T0, 1e-9);
-  EXPECT_JACOBIAN_NEAR(r.d_uv_d_xi, w.d_uv_d_xi, 1e-9);
+  for (bool acc : {false, true}) {
+    RsFrame host = host_, target = target_;
+    if (acc) host.w_dot = kHostWDot, target.w_dot = kTargetWDot;
+    const RsHostProjection r = projectRollingShutter(*cam_, timing_, host, target, b, v_h, rho);
+    // The host saw the point at its row's time: X = T_h_w(t_h)^-1 (b / rho).
+    const SE3d T_h_w = acc ? rsPoseAt(host, timing_.rowTime(v_h)) : SE3d::exp(host.xi * timing_.rowTime(v_h)) * host.T_c_w0;
+    const Vec3 X = T_h_w.inverse() * Vec3(b / rho);
+    const RsProjection w = projectRollingShutter(*cam_, timing_, target, X);
+    ASSERT_TRUE(r.valid);
+    EXPECT_LT((r.uv - w.uv).norm(), 1e-9);
+    EXPECT_JACOBIAN_NEAR(r.d_uv_d_T0, w.d_uv_d_T0, 1e-9);
+    EXPECT_JACOBIAN_NEAR(r.d_uv_d_xi, w.d_uv_d_xi, 1e-9);
+  }
 }
 
+// With w_dot (RsFrame: the rows' rotation to second order) on host and target, every Jacobian is checked
+// again: the twists' through A(t), the line delay's through A's own time derivative.
 TEST_F(RsHostProjectionTest, JacobiansMatchNumeric) {
+  for (bool acc : {false, true})
   for (bool top_down : {true, false}) {
+    const RsFrame host_ = acc ? withWDot(this->host_, kHostWDot) : this->host_;
+    const RsFrame target_ = acc ? withWDot(this->target_, kTargetWDot) : this->target_;
     const RowTiming tm = RowTiming::rolling(timing_.y0, 4e-5, top_down);
     for (const Vec2& px : {Vec2(70.0, 200.0), Vec2(250.0, 30.0), Vec2(159.5, 127.5), Vec2(0.0, 255.0)}) {
       for (double rho : {0.05, 0.5, 3.0}) {
@@ -71,14 +87,21 @@ TEST_F(RsHostProjectionTest, JacobiansMatchNumeric) {
         hostPoint(px, b, v_h);
         const RsHostProjection r = projectRollingShutter(*cam_, tm, host_, target_, b, v_h, rho, exact());
         if (!r.valid) continue;  // a corner of the wide-angle host may leave the target's view
-        SCOPED_TRACE(::testing::Message() << "px " << px.transpose() << " rho " << rho << " top_down " << top_down);
+        SCOPED_TRACE(::testing::Message() << "px " << px.transpose() << " rho " << rho << " top_down " << top_down
+                                          << " w_dot " << acc);
         const auto uvAt = [&](const RowTiming& t, const RsFrame& h, const RsFrame& f, double r_) {
           return projectRollingShutter(*cam_, t, h, f, b, v_h, r_, exact(false)).uv;
         };
-        const auto byHostPose = [&](const SE3d& T) { return uvAt(tm, RsFrame{T, host_.xi}, target_, rho); };
-        const auto byHostTwist = [&](const Vec6& xi) { return uvAt(tm, RsFrame{host_.T_c_w0, xi}, target_, rho); };
-        const auto byTargetPose = [&](const SE3d& T) { return uvAt(tm, host_, RsFrame{T, target_.xi}, rho); };
-        const auto byTargetTwist = [&](const Vec6& xi) { return uvAt(tm, host_, RsFrame{target_.T_c_w0, xi}, rho); };
+        const auto byHostPose = [&](const SE3d& T) { return uvAt(tm, RsFrame{T, host_.xi, host_.w_dot}, target_, rho); };
+        const auto byHostTwist = [&](const Vec6& xi) {
+          return uvAt(tm, RsFrame{host_.T_c_w0, xi, host_.w_dot}, target_, rho);
+        };
+        const auto byTargetPose = [&](const SE3d& T) {
+          return uvAt(tm, host_, RsFrame{T, target_.xi, target_.w_dot}, rho);
+        };
+        const auto byTargetTwist = [&](const Vec6& xi) {
+          return uvAt(tm, host_, RsFrame{target_.T_c_w0, xi, target_.w_dot}, rho);
+        };
         const auto byIdepth = [&](double r_) { return uvAt(tm, host_, target_, r_); };
         const auto byDelay = [&](double ld) {
           RowTiming t = tm;

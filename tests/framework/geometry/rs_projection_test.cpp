@@ -47,8 +47,8 @@ class RsProjectionTest : public ::testing::Test {
       o.jacobians = false;
       return projectRollingShutter(*cam_, tm, ff, XX, o).uv;
     };
-    const auto byPose = [&](const SE3d& T) { return uvAt(timing, RsFrame{T, f.xi}, X); };
-    const auto byTwist = [&](const Vec6& xi) { return uvAt(timing, RsFrame{f.T_c_w0, xi}, X); };
+    const auto byPose = [&](const SE3d& T) { return uvAt(timing, RsFrame{T, f.xi, f.w_dot}, X); };
+    const auto byTwist = [&](const Vec6& xi) { return uvAt(timing, RsFrame{f.T_c_w0, xi, f.w_dot}, X); };
     const auto byPoint = [&](const Vec3& XX) { return uvAt(timing, f, XX); };
     const auto byDelay = [&](double ld) {
       RowTiming tm = timing;
@@ -166,6 +166,42 @@ TEST_F(RsProjectionTest, WorldPointJacobiansMatchNumeric) {
     for (double y : {-0.4, 0.0, 0.35})
       for (double x : {-0.5, 0.25}) checkWorldJacobians(tm, target_, worldPoint(x, y, 2.0));
   }
+}
+
+// RsFrame::w_dot (the rows' rotation to second order): the solution satisfies the constraint with the
+// rows' poses of rsPoseAt, which agree with exp(xi t + (0; w_dot t^2 / 2)) T0 to O(t^3), the shift is
+// the size the angular acceleration predicts, and every Jacobian matches numeric differences.
+TEST_F(RsProjectionTest, AngularAccelerationTakesTheRowsToSecondOrder) {
+  RsFrame f = target_;
+  f.w_dot = Vec3(-9.0, 15.0, 25.0);
+  const RowTiming tm = RowTiming::rolling(timing_.y0, 5e-5, true);
+  const double t_edge = tm.rowTime(0.0);
+  Vec6 xi2 = f.xi * t_edge;
+  xi2.tail<3>() += 0.5 * t_edge * t_edge * f.w_dot;
+  const SE3d T_exact = SE3d::exp(xi2) * f.T_c_w0;
+  const SE3d T_model = rsPoseAt(f, t_edge);
+  const double second_order = 0.5 * t_edge * t_edge * f.w_dot.norm();  // ~6e-4 rad here
+  const double third_order = f.w_dot.norm() * f.xi.norm() * std::pow(std::abs(t_edge), 3);
+  EXPECT_LT((T_exact.inverse() * T_model).log().norm(), third_order);
+  EXPECT_LT(third_order, 0.05 * second_order);
+  EXPECT_GT((T_exact.inverse() * SE3d::exp(f.xi * t_edge) * f.T_c_w0).log().norm(), 0.9 * second_order);
+  double max_shift = 0.0;
+  for (double y : {-0.4, 0.0, 0.35}) {
+    for (double x : {-0.5, 0.25}) {
+      const Vec3 X = worldPoint(x, y, 2.0);
+      const RsProjection r = projectRollingShutter(*cam_, tm, f, X, exact());
+      ASSERT_TRUE(r.valid);
+      Vec2 uv;
+      ASSERT_TRUE(cam_->project(Vec3(rsPoseAt(f, r.t_s) * X), uv));
+      EXPECT_LT((uv - r.uv).norm(), 1e-8);
+      EXPECT_NEAR(r.t_s, tm.rowTime(r.uv.y()), 1e-9);
+      max_shift = std::max(max_shift, (r.uv - projectRollingShutter(*cam_, tm, target_, X, exact()).uv).norm());
+      checkWorldJacobians(tm, f, X);
+    }
+  }
+  // At the outer rows (|t| ~ 6 ms) w_dot t^2 / 2 is ~0.6 mrad: ~0.15 px at f = 250.
+  EXPECT_GT(max_shift, 0.05);
+  EXPECT_LT(max_shift, 0.5);
 }
 
 TEST_F(RsProjectionTest, JacobiansAtZeroLineDelay) {

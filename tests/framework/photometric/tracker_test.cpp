@@ -233,21 +233,23 @@ TEST(FrameTracker, OwnProjectionMatchesRsProjectionAndNumericJacobian) {
   // The tracker projects its points itself (global shutter: one batch; rolling shutter: its own row
   // solve with only d uv / d T0, warm-started rows); it must agree with geometry/rs_projection.h and
   // with numeric differences of its own uv.
+  // With w_dot (RsFrame: the rows' rotation to second order) as well.
   const Fixture& f = fixture();
   const Vec6 xi = twist(1.2, -0.4, 0.6, 0.5, -1.0, 0.4);
+  for (const Vec3& w_dot : {Vec3(0.0, 0.0, 0.0), Vec3(-9.0, 15.0, 25.0)})
   for (const RowTiming& timing : {RowTiming::rolling(f.K.height * 0.5 - 0.5, 40e-6, true),
                                   RowTiming::rolling(f.K.height * 0.5 - 0.5, 40e-6, false),
                                   RowTiming::global(f.K.height * 0.5 - 0.5)}) {
-    SCOPED_TRACE("direction " + std::to_string(timing.direction));
+    SCOPED_TRACE("direction " + std::to_string(timing.direction) + " w_dot " + std::to_string(w_dot.norm()));
     FrameTracker tracker(TrackerOptions(), f.camera, timing);
     tracker.setReference(f.ref);
     Eigen::Matrix2Xd uv;
     std::vector<uint8_t> valid;
     std::vector<Eigen::Matrix<double, 2, 6>> D;
     Eigen::Matrix3Xd X_w;
-    tracker.projectReference(0, f.T_new, xi, &uv, &valid, &D, &X_w);
+    tracker.projectReference(0, f.T_new, xi, &uv, &valid, &D, &X_w, w_dot);
     std::vector<RsProjection> ref;
-    projectRollingShutter(f.camera, timing, RsFrame{f.T_new, xi}, X_w, ref);
+    projectRollingShutter(f.camera, timing, RsFrame{f.T_new, xi, w_dot}, X_w, ref);
     int checked = 0;
     for (Eigen::Index i = 0; i < uv.cols(); i += 37) {
       const size_t s = static_cast<size_t>(i);
@@ -259,7 +261,7 @@ TEST(FrameTracker, OwnProjectionMatchesRsProjectionAndNumericJacobian) {
           [&](const SE3d& T) {
             Eigen::Matrix2Xd q;
             std::vector<uint8_t> v;
-            tracker.projectReference(0, T, xi, &q, &v, nullptr);
+            tracker.projectReference(0, T, xi, &q, &v, nullptr, nullptr, w_dot);
             return Vec2(q.col(i));
           },
           f.T_new, test::leftPlus<SE3d>, 6, 1e-5);

@@ -114,5 +114,35 @@ TEST(InertialState, WithTheOptionsOffTheFramesTwistIsLeftAlone) {
   }
 }
 
+// imu.readout_angular_acceleration: RsFrame::w_dot at a frame's time is the rate of change of the
+// camera's true rotation rate (the twist's rotation, left of T_C_W), from the gyroscope at the IMU time
+// (the 4 ms offset applied); zero with the option off, for a global shutter, or past the IMU data.
+// Shown once: with the sign of the difference reversed the first check misses by twice the rate.
+TEST(InertialState, ReadoutAngularAccelerationIsTheRateOfChangeOfTheTwistsRotation) {
+  GyroTwistFixture f;
+  for (const bool on : {true, false})
+    for (const bool rolling : {true, false}) {
+      InertialOptions o;
+      o.enabled = true;
+      o.readout_angular_acceleration = on;
+      InertialState st(o, f.sensors, rolling, 0.1, 0.02, f.globals);
+      for (const ImuSample& s : test::simulateImu(f.tr, 0.0, 3.0, test::ImuSimOptions())) st.addImu(s);
+      for (double t : {0.4, 1.2, 2.55}) {
+        const Vec3 w_dot = st.readoutWDot(test::secToNs(t));
+        if (!on || !rolling) {
+          EXPECT_EQ(w_dot, Vec3::Zero()) << "t " << t;
+          continue;
+        }
+        const double h = 1e-3;
+        const Vec3 truth = (f.trueRate(t + h) - f.trueRate(t - h)) / (2.0 * h);
+        EXPECT_GT(truth.norm(), 0.3) << "accelerating: the test is not vacuous";
+        // The central difference over +-10 ms of a smooth rate: O(h^2) off, well inside 2 %.
+        EXPECT_LT((w_dot - truth).norm(), 0.02 * truth.norm()) << "t " << t << ": " << w_dot.transpose()
+                                                               << " against " << truth.transpose();
+      }
+      EXPECT_EQ(st.readoutWDot(test::secToNs(3.5)), Vec3::Zero()) << "past the IMU data";
+    }
+}
+
 }  // namespace
 }  // namespace rsvio

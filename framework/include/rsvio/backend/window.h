@@ -158,6 +158,10 @@ struct Keyframe {
   std::shared_ptr<const ImuFactor> imu_factor;
   bool twist_energy = false;
   Vec3 gyro_at_t = Vec3::Zero();
+  // Rolling shutter: the rate of change of the twist's rotation at t_ns (rad/s^2), from the gyroscope
+  // (imu.readout_angular_acceleration), known and not optimised: the rows' rotation to second order
+  // (RsFrame::w_dot, geometry/rs_projection.h). Zero otherwise.
+  Vec3 w_dot = Vec3::Zero();
 
   std::vector<ActivePoint> points;         // active points hosted here
   std::vector<CandidatePoint> candidates;  // waiting for activation (frontend/candidate_points.h)

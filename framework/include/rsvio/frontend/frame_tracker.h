@@ -107,6 +107,7 @@ struct TrackingReference {
   int64_t t_ns = 0;
   SE3d T_c_w;                           // central pose
   Vec6 twist = Vec6::Zero();            // per second
+  Vec3 w_dot = Vec3::Zero();            // the twist rotation's rate of change (RsFrame::w_dot), rad/s^2
   AffineBrightness affine;
   double exposure_ms = std::numeric_limits<double>::quiet_NaN();
   std::shared_ptr<const ImagePyramid> pyramid;
@@ -117,6 +118,7 @@ struct TrackingReference {
 struct TrackingFrame {
   int64_t t_ns = 0;
   Vec6 twist = Vec6::Zero();            // kept fixed (prior or previous frame)
+  Vec3 w_dot = Vec3::Zero();            // RsFrame::w_dot, kept fixed (the gyroscope's; zero without it)
   double exposure_ms = std::numeric_limits<double>::quiet_NaN();
   AffineBrightness affine_guess;        // usually the previous frame's
 };
@@ -183,10 +185,11 @@ class FrameTracker {
 
   // The reference points of one level projected into a frame with central pose T_c_w and twist (the
   // tracker's own rolling-shutter solve), with d uv / d T_c_w (left perturbation, row dependence
-  // included). Level-0 pixels; X_w (optional) receives the points in the world. For tests and diagnostics.
+  // included). Level-0 pixels; X_w (optional) receives the points in the world; w_dot the frame's
+  // RsFrame::w_dot. For tests and diagnostics.
   void projectReference(int level, const SE3d& T_c_w, const Vec6& twist, Eigen::Matrix2Xd* uv,
                         std::vector<uint8_t>* valid, std::vector<Eigen::Matrix<double, 2, 6>>* d_uv_d_T,
-                        Eigen::Matrix3Xd* X_w = nullptr) const;
+                        Eigen::Matrix3Xd* X_w = nullptr, const Vec3& w_dot = Vec3::Zero()) const;
 
  private:
   struct LevelPoints;

@@ -118,11 +118,39 @@ struct RsProjectionOptions {
   bool jacobians = true;
 };
 
-// One target frame: central pose and twist (eq. 6).
+// One target frame: central pose and twist (eq. 6), and optionally the rate of change of the twist's
+// rotation, w_dot (rad/s^2, the camera's angular acceleration with the twist's sign: w = -omega_c, so
+// w_dot = -d omega_c / dt). w_dot is known (the gyroscope's, imu.readout_angular_acceleration), not
+// optimised: it takes the rows' rotation to second order in the row time,
+//   T_c_w(t) = exp((0; w_dot t^2 / 2)) exp(xi t) T_c_w^0,
+// which is exp(xi t + (0; w_dot t^2 / 2)) T_c_w^0 up to O(t^3). Zero (the default) is eq. 6 exactly.
 struct RsFrame {
   SE3d T_c_w0;
   Vec6 xi = Vec6::Zero();  // per second, (translation; rotation)
+  Vec3 w_dot = Vec3::Zero();
 };
+
+// The second-order rotation of RsFrame::w_dot at row time t: A = exp(w_dot t^2 / 2) and its time
+// derivative's tangent g = Jl(w_dot t^2 / 2) w_dot t (d A / d t = [g]x A). Identity and zero for a zero w_dot.
+struct ReadoutRotation {
+  Mat3 A = Mat3::Identity();
+  Vec3 g = Vec3::Zero();
+  ReadoutRotation() = default;
+  ReadoutRotation(const Vec3& w_dot, double t) {
+    if (w_dot.isZero(0.0) || t == 0.0) return;
+    const Vec3 phi = (0.5 * t * t) * w_dot;
+    A = SO3d::exp(phi).matrix();
+    g = SO3d::leftJacobian(phi) * (t * w_dot);
+  }
+};
+
+// The pose of a frame's row at row time t (the contract's T_c_w(t); not for hot loops).
+inline SE3d rsPoseAt(const RsFrame& f, double t) {
+  if (t == 0.0) return f.T_c_w0;
+  const SE3d T = SE3d::exp(f.xi * t) * f.T_c_w0;
+  if (f.w_dot.isZero(0.0)) return T;
+  return SE3d(SO3d::exp((0.5 * t * t) * f.w_dot), Vec3::Zero()) * T;
+}
 
 // A world point projected into the target.
 struct RsProjection {
@@ -156,20 +184,23 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
                            const Eigen::VectorXd& v_h, const Eigen::VectorXd& idepth,
                            std::vector<RsHostProjection>& out, const RsProjectionOptions& options = {});
 
-// The part of a host point's projection that does not depend on the target: the rotation E of
-// exp(-xi_h t_h) at its row time t_h = t(v_h), the point Z = exp(-xi_h t_h) (b / rho) in the host's
-// central frame, and dZ = [I, -[Z]x] Jl(-xi_h t_h) (d Z / d xi_h before its factor -t_h; zero for
-// t_h = 0 or without Jacobians). rsHostPoint() is the one place these are computed, so a projection
+// The part of a host point's projection that does not depend on the target: the rotation E that takes
+// the bearing into the host's central frame at its row time t_h = t(v_h), exp(-xi_h t_h) A_h(t_h)^T with
+// A_h the host's ReadoutRotation (identity without w_dot), the point Z = T_h_w(t_h)-to-central of
+// (b / rho) = exp(-xi_h t_h) A_h^T (b / rho) + p, dZ = [I, -[Z]x] Jl(-xi_h t_h) (d Z / d xi_h before its
+// factor -t_h; zero for t_h = 0 or without Jacobians), and dZ_dt_acc, the w_dot part of d Z / d t_h
+// (-E (g x b / rho); zero without w_dot). rsHostPoint() is the one place these are computed, so a projection
 // from cached host points (the bundle adjustment computes them once per point and linearisation and
 // reuses them for every target) is bit-identical to the one that computes them.
 struct RsHostPoint {
   Mat3 E = Mat3::Identity();
   Vec3 Z = Vec3::Zero();
   Eigen::Matrix<double, 3, 6> dZ = Eigen::Matrix<double, 3, 6>::Zero();
+  Vec3 dZ_dt_acc = Vec3::Zero();
 };
-// ex_h = TwistExp(xi_h); rho > 0 and finite (the caller skips the others).
+// ex_h = TwistExp(xi_h); rho > 0 and finite (the caller skips the others); w_dot_h the host's RsFrame::w_dot.
 RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, const Vec3& bearing_h, double rho,
-                        bool jacobians);
+                        bool jacobians, const Vec3& w_dot_h = Vec3::Zero());
 // As above, with the host points given (host_points[i] = rsHostPoint(...) of column i for every column
 // with a valid inverse depth; the others are not read).
 void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, const RsFrame& host,

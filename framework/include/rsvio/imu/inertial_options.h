@@ -36,6 +36,13 @@ struct InertialOptions {
   // at the image's time (gyro bias 0) instead of fitted from the corner tracks
   // (backend.init_rotation_rates, MonoInitializer::setRateSource); the two keyframes start with them.
   bool init_rates_from_gyro = false;
+  // Rolling shutter: the rows' rotation to second order in the row time, with the rate of change of the
+  // twist's rotation from the gyroscope (RsFrame::w_dot, geometry/rs_projection.h): each keyframe's and
+  // each tracked frame's w_dot = -R_Cm_I d omega / dt at its time (central difference of the gyroscope
+  // over +-10 ms; the bias cancels), known and not optimised. The constant twist of eq. 6 alone misses
+  // 0.5 |d omega / dt| t^2 at row time t: about 0.4 px at the outer rows of Table I's sequences 9 and 10
+  // (docs/vio.md, "The rows' rotation to second order"). Before and after the initialisation.
+  bool readout_angular_acceleration = false;
   // Rolling shutter: the weight of the smooth-motion twist prior (backend/smooth_motion_term.h) of a
   // keyframe that has the IMU twist energy (made after the initialisation); 1: as before it. Lighter
   // weights lost track or were less accurate with motion.imu's default Sigma (0.02 rad/s, 0.1 m/s;
