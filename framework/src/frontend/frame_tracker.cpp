@@ -64,6 +64,7 @@ void FrameTracker::setReference(const TrackingReference& reference) {
     const ResidualOptions& ro = options_.residual;
     std::vector<Vec3> X;
     const TwistExp ref_exp(ref_.twist);
+    const ReadoutRotation ref_ra(ref_.w_dot);
     for (size_t i = 0; i < uv0.size(); ++i) {
       if (!valid[i]) continue;
       PatternHost host;
@@ -72,7 +73,7 @@ void FrameTracker::setReference(const TrackingReference& reference) {
       const double t_h = timing_.rowTime(uv0[i].y());
       const Vec3 Z_c = bearing.col(static_cast<Eigen::Index>(i)) / idepth[i];
       // With w_dot: T_h(t_h) = A(t_h) exp(xi t_h) T_h0, so Z = exp(-xi t_h) A^T Z_c.
-      const Vec3 Z = t_h == 0.0 ? Z_c : ref_exp.apply(-t_h, ReadoutRotation(ref_.w_dot, t_h).A.transpose() * Z_c);
+      const Vec3 Z = t_h == 0.0 ? Z_c : ref_exp.apply(-t_h, ref_ra.A(t_h).transpose() * Z_c);
       X.push_back(T_w_h0 * Z);
       L->host.push_back(host);
       L->host_uv0.push_back(uv0[i]);
@@ -120,7 +121,8 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
   }
   const Vec3 xi_v = target.xi.head<3>(), xi_w = target.xi.tail<3>();
   const TwistExp ex(target.xi);
-  const bool acc = !target.w_dot.isZero(0.0);  // RsFrame::w_dot: P = A(t) exp(xi t) P0
+  const ReadoutRotation ra(target.w_dot);
+  const bool acc = !ra.zero();  // RsFrame::w_dot: P = A(t) exp(xi t) P0
   if (B.row.size() != static_cast<size_t>(n)) B.row.assign(static_cast<size_t>(n), timing_.y0);
   B.uv.resize(2, n);
   B.valid.assign(static_cast<size_t>(n), 0);
@@ -133,7 +135,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       const int i = B.active[static_cast<size_t>(k)];
       const double ti = timing_.rowTime(B.row[static_cast<size_t>(i)]);
       B.P.col(k) = ex.apply(ti, Vec3(B.P0.col(i)));  // eq. 6 at the row's time (eq. 7)
-      if (acc) B.P.col(k) = ReadoutRotation(target.w_dot, ti).A * B.P.col(k);
+      if (acc) B.P.col(k) = ra.A(ti) * B.P.col(k);
     }
     camera_.project(B.P, B.uv_a, B.valid_a, &B.J);
     B.still.clear();
@@ -143,10 +145,10 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       if (!B.valid_a[static_cast<size_t>(k)]) continue;
       const Jac23& J = B.J[static_cast<size_t>(k)];
       const Vec3 Pk = B.P.col(k);
-      ReadoutRotation rr;
-      if (acc) rr = ReadoutRotation(target.w_dot, timing_.rowTime(B.row[si]));
       // d P / d t: xi^ P, or with w_dot g x P + A (xi_v + xi_w x A^T P)
-      const Vec3 dPdt = acc ? Vec3(rr.g.cross(Pk) + rr.A * (xi_v + xi_w.cross(rr.A.transpose() * Pk)))
+      const double tk = timing_.rowTime(B.row[si]);
+      const Mat3 Ak = acc ? ra.A(tk) : Mat3::Identity();
+      const Vec3 dPdt = acc ? Vec3(ra.g(tk).cross(Pk) + Ak * (xi_v + xi_w.cross(Ak.transpose() * Pk)))
                             : Vec3(xi_v + xi_w.cross(Pk));
       const Vec2 a = J * dPdt * c;
       const double denom = 1.0 - a.y();
@@ -166,7 +168,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
       B.uv.col(i) = B.uv_a.col(k) + a * step;
       B.valid[si] = 1;
       if (linearize) {
-        Mat26 D = acc ? Mat26(J * (rr.A * ex.rotation(ti)) * dLeftAction(B.P0.col(i)))
+        Mat26 D = acc ? Mat26(J * (Ak * ex.rotation(ti)) * dLeftAction(B.P0.col(i)))
                       : Mat26(J * ex.rotation(ti) * dLeftAction(B.P0.col(i)));
         const double inv = 1.0 / denom;
         D.row(0) += (a.x() * inv) * D.row(1);

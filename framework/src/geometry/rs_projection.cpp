@@ -61,7 +61,8 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
   const Vec3 xi_w = target.xi.tail<3>();
 
   const TwistExp ex(target.xi);
-  const bool acc = !target.w_dot.isZero(0.0);  // the rows' second-order rotation (RsFrame::w_dot)
+  const ReadoutRotation ra(target.w_dot);
+  const bool acc = !ra.zero();  // the rows' second-order rotation (RsFrame::w_dot)
   std::vector<Vec3> P0(n), P(n);
   std::vector<Mat3> E(n);  // rotation of exp(xi t) at the current row (times A(t) with w_dot)
   std::vector<Vec3> dPdt(n);  // d P / d t at the current row, fixed state
@@ -92,12 +93,11 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
       P[i] = E[i] * P0[i] + p;
       dPdt[i] = xi_v + xi_w.cross(P[i]);  // d/dt exp(xi t) = xi^ exp(xi t)
       if (acc) {  // P = A(t) exp(xi t) P0: d P / d t = g x P + A (xi_v + xi_w x exp(xi t) P0)
-        const ReadoutRotation rr(target.w_dot, t);
-        A[i] = rr.A;
+        A[i] = ra.A(t);
         Pxi[i] = P[i];
-        P[i] = rr.A * Pxi[i];
-        E[i] = rr.A * E[i];
-        dPdt[i] = rr.g.cross(P[i]) + rr.A * dPdt[i];
+        P[i] = A[i] * Pxi[i];
+        E[i] = A[i] * E[i];
+        dPdt[i] = ra.g(t).cross(P[i]) + A[i] * dPdt[i];
       }
       Pa.col(static_cast<Eigen::Index>(k)) = P[i];
     }
@@ -170,10 +170,10 @@ RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, cons
   Vec3 p;
   ex_h.at(-t_h, h.E, p);  // exp(xi_h (-t_h))
   if (!w_dot_h.isZero(0.0) && t_h != 0.0) {  // T_h_w(t_h) = A_h exp(xi_h t_h) T_h_w0: undo A_h first
-    const ReadoutRotation rr(w_dot_h, t_h);
-    h.E = h.E * rr.A.transpose();
+    const ReadoutRotation ra(w_dot_h);
+    h.E = h.E * ra.A(t_h).transpose();
     // d (A^T y) / d t = -A^T (g x y), y = b / rho
-    if (jacobians) h.dZ_dt_acc = -h.E * rr.g.cross(Vec3(bearing_h / rho));
+    if (jacobians) h.dZ_dt_acc = -h.E * ra.g(t_h).cross(Vec3(bearing_h / rho));
   }
   h.Z = h.E * Vec3(bearing_h / rho) + p;
   if (jacobians && t_h != 0.0) h.dZ = dLeftActionTimesJl(h.Z, -xi_h * t_h);
