@@ -3,7 +3,8 @@
 //
 // Contract
 // - Target frame: central pose T_c_w^0 (world -> camera, at the image timestamp, i.e. raw row y0) and
-//   twist xi = (translation; rotation) per second, left: T_c_w(t) = exp(xi t) T_c_w^0 (eq. 6).
+//   twist xi = (translation; rotation) per second, left: T_c_w(t) = exp(xi t) T_c_w^0 (eq. 6); with a
+//   known angular acceleration w_dot (RsFrame, zero by default) the rows also turn by exp(w_dot t^2 / 2).
 // - Raw row v is read at t(v) = dt_dv (v - y0), dt_dv = direction * line_delay_s (RowTiming;
 //   conventions.md "Time"). Rows are raw (distorted) rows: the camera projects through its distortion,
 //   so the row IS f_d of eq. 7 and no undistorted image is needed.
