@@ -40,9 +40,14 @@ void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const
 
 Vec3 pointInWorld(const ActivePoint& p, const RowTiming& timing, bool rolling) {
   const Keyframe& host = *p.host;
-  if (!rolling) return host.state.T_c_w.inverse() * Vec3(p.bearing / p.idepth);
-  return rsPoseAt(RsFrame{host.state.T_c_w, host.state.twist, host.w_dot}, timing.rowTime(p.v)).inverse() *
-         Vec3(p.bearing / p.idepth);
+  Vec3 Z = p.bearing / p.idepth;
+  if (!rolling) return host.state.T_c_w.inverse() * Z;
+  const double t_h = timing.rowTime(p.v);
+  // The host saw the point at its row's time: X = T_h_w(t_h)^-1 (b / rho). Without w_dot in eq. 6's own
+  // form (the bits of every run before w_dot existed), with it through rsPoseAt (rs_projection.h).
+  if (!host.w_dot.isZero(0.0))
+    return rsPoseAt(RsFrame{host.state.T_c_w, host.state.twist, host.w_dot}, t_h).inverse() * Z;
+  return host.state.T_c_w.inverse() * Vec3(SE3d::exp(-host.state.twist * t_h) * Z);
 }
 
 KeyframeWindow::KeyframeWindow(const WindowSetup& setup, const CameraModel& camera, const RowTiming& timing,
