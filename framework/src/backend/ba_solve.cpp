@@ -376,6 +376,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
   Eigen::VectorXd dx_c, dx_p;
   const int kd = config_.layout.kfDim();
   int failures = 0;
+  int rejected_in_row = 0;
   for (int it = 0; it < max_iterations; ++it) {
     std::string msg;
     const bool ok = full ? ba::solveFull(m, m.cur, config_, solver_, lambda, dx_c, dx_p, &msg)
@@ -418,6 +419,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       ba::addCameraTerms(m, m.trial, config_, terms_);
       std::swap(m.cur, m.trial);
       ++s.accepted;
+      rejected_in_row = 0;
       const double rel = (e - e_new) / std::max(e, 1e-300);
       e = e_new;
       lambda *= 0.5;
@@ -427,6 +429,8 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       if (m.globals && config_.layout.globalDim() > 0) m.globals->state = m.globals->backup;
       for (size_t i = 0; i < m.points.size(); ++i) m.points[i]->idepth = idepth_backup[i];
       lambda *= 4.0;
+      ++s.rejected;
+      if (config_.max_rejected_steps > 0 && ++rejected_in_row >= config_.max_rejected_steps) break;
     }
   }
   s.energy_final = e;

@@ -22,6 +22,9 @@ ParamTable backendParamTable() {
       paramDouble("lambda_initial", d.lambda_initial, 0.0, 1e6, "", "initial relative LM damping"),
       paramDouble("step_threshold", d.step_threshold, 0.0, 1.0, "",
                   "stop iterating when the relative energy decrease is below this"),
+      paramInt("max_rejected_steps", d.max_rejected_steps, 0, 100, "",
+               "stop iterating after this many rejected Levenberg-Marquardt steps in a row (0: no such stop; "
+               "docs/performance.md, Rejected steps)"),
       paramDouble("marg_weight_factor", d.marg_weight_factor, 0.0, 1.0, "",
                   "factor on the information of marginalised points (DSO: 0.25)"),
       paramBool("marg_project_scale", d.marg_project_scale,
@@ -93,6 +96,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.line_delay_hold_keyframes = static_cast<int>(p.getInt("line_delay_hold_keyframes"));
   o.lambda_initial = p.getDouble("lambda_initial");
   o.step_threshold = p.getDouble("step_threshold");
+  o.max_rejected_steps = static_cast<int>(p.getInt("max_rejected_steps"));
   o.marg_weight_factor = p.getDouble("marg_weight_factor");
   o.marg_project_scale = p.getBool("marg_project_scale");
   o.min_idepth_hessian_marg = p.getDouble("min_idepth_hessian_marg");

@@ -76,6 +76,7 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   bc.estimate_affine = estimate_affine;
   bc.lambda_initial = bo.lambda_initial;
   bc.step_threshold = bo.step_threshold;
+  bc.max_rejected_steps = bo.max_rejected_steps;
   bc.twist_regularization = bo.twist_regularization;
   bc.line_delay_min_keyframes = bo.line_delay_hold_keyframes;
   bc.threads = threads;

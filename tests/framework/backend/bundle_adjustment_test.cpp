@@ -93,6 +93,40 @@ TEST(BundleAdjustment, ConvergesFromPerturbedPosesAndDepths) {
   EXPECT_LT(rel[rel.size() / 2], 0.01);
 }
 
+// BundleAdjustmentConfig::max_rejected_steps: with no stop on the energy decrease, a converged window
+// keeps proposing steps that do not lower the energy; the limit ends the iterations after that many
+// rejected steps in a row, at the energy the unlimited run also keeps (a rejected step changes nothing).
+TEST(BundleAdjustment, StopsAfterTheConfiguredRejectedSteps) {
+  auto run = [](int max_rejected, double* energy) {
+    TestWindow w(4);
+    w.addPoints(0, 300);
+    w.addPoints(1, 200, 5);
+    w.window[0]->gauge = true;
+    perturb(w, 0.02, 0.01, 0.05, 7);
+    auto solver = dense();
+    BundleAdjustmentConfig c = gsConfig();
+    c.step_threshold = 0.0;
+    c.max_rejected_steps = max_rejected;
+    BundleAdjuster ba(c, w.camera, w.timing, *solver);
+    MarginalizationPrior prior;
+    const BundleAdjustmentStats s = ba.optimize(w.window, prior, 16);
+    *energy = s.energy_final;
+    return s;
+  };
+  double e_all = 0, e_two = 0;
+  const BundleAdjustmentStats all = run(0, &e_all);
+  const BundleAdjustmentStats two = run(2, &e_two);
+  EXPECT_FALSE(all.solver_failed || two.solver_failed);
+  EXPECT_EQ(all.iterations, 16);
+  ASSERT_GE(all.rejected, 3);  // the unlimited run does reject steps once converged
+  EXPECT_EQ(all.iterations, all.accepted + all.rejected);
+  EXPECT_LT(two.iterations, 16);
+  EXPECT_GE(two.rejected, 2);
+  EXPECT_EQ(two.iterations, two.accepted + two.rejected);
+  EXPECT_LE(e_all, e_two);
+  EXPECT_LT(e_two, 1.001 * e_all);  // it stopped converged, not early
+}
+
 // At the true states, the rolling-shutter projection explains rolling-shutter images clearly better
 // than the same states seen through a global-shutter model (twists ignored).
 TEST(BundleAdjustment, RollingShutterEnergyExplainsRollingShutterImages) {

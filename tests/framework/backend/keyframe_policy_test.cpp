@@ -310,6 +310,7 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["line_delay_hold_keyframes"] = o.line_delay_hold_keyframes;
   got["lambda_initial"] = o.lambda_initial;
   got["step_threshold"] = o.step_threshold;
+  got["max_rejected_steps"] = o.max_rejected_steps;
   got["marg_weight_factor"] = o.marg_weight_factor;
   got["marg_project_scale"] = o.marg_project_scale;
   got["min_idepth_hessian_marg"] = o.min_idepth_hessian_marg;

@@ -70,6 +70,10 @@ struct BundleAdjustmentConfig {
   double affine_prior_b = 0.0;
   double lambda_initial = 1e-4;
   double step_threshold = 1e-4;    // relative energy decrease that ends the iterations
+  // Consecutive rejected LM steps that end the iterations (0: only max_iterations and step_threshold
+  // end them). A rejected step's relative damping (1e-4 x 4^k) barely changes the next step, so
+  // further tries mostly repeat it (docs/performance.md, "Rejected steps").
+  int max_rejected_steps = 0;
   double twist_regularization = 1e-6;
   // Monocular runs: remove the scale direction (a null direction of the photometric energy) from every
   // step, so the damping cannot move the scale (DSO orthogonalises its steps the same way). Off when
@@ -87,6 +91,7 @@ struct BundleAdjustmentConfig {
 struct BundleAdjustmentStats {
   int iterations = 0;              // linearisations after the first
   int accepted = 0;
+  int rejected = 0;                // steps whose energy was not lower (iterations - accepted, less solver failures)
   double energy_initial = 0.0;     // total energy before / after
   double energy_final = 0.0;
   double photometric_energy = 0.0; // inlier photometric energy at the end
