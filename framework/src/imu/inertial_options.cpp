@@ -18,6 +18,10 @@ ParamTable inertialParamTable() {
       paramBool("estimate_time_offset", d.estimate_time_offset,
                 "estimate the camera-IMU time offset online (t_imu = t_cam + offset, Kalibr's sign); starts "
                 "from the calibration's (plus time_offset_correction_ms)"),
+      paramDouble("init_time_offset_search_ms", d.init_time_offset_search_ms, 0.0, 500.0, "ms",
+                  "with estimate_time_offset: before the visual-inertial initialisation, at each attempt, the offset "
+                  "is searched within +- this of the starting one by the keyframes' rotations against the "
+                  "gyroscope, and the online estimate starts there (0: no search; docs/vio.md, Time offset)"),
       paramDouble("time_offset_correction_ms", d.time_offset_correction_ms, -1000.0, 1000.0, "ms",
                   "added to the calibration's camera-IMU time offset (t_imu = t_cam + offset): the value rsvio "
                   "diagnose measures when the calibration lacks it"),
@@ -100,6 +104,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.imu_weight = p.getDouble("imu_weight");
   o.twist_weight = p.getDouble("twist_weight");
   o.estimate_time_offset = p.getBool("estimate_time_offset");
+  o.init_time_offset_search_ms = p.getDouble("init_time_offset_search_ms");
   o.time_offset_correction_ms = p.getDouble("time_offset_correction_ms");
   o.frame_twist_from_imu = p.getBool("frame_twist_from_imu");
   o.smooth_motion_weight = p.getDouble("smooth_motion_weight");

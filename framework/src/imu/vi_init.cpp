@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "rsvio/core/time.h"
@@ -51,6 +52,32 @@ Vec3 estimateGyroBias(const std::vector<ImuPreintegration>& pre, const std::vect
     bias.gyro -= H.ldlt().solve(g);
   }
   return bias.gyro;
+}
+
+std::vector<Pose> posesOf(const std::vector<ViInitKeyframe>& kfs, const SE3d& T_cm_i) {
+  std::vector<Pose> poses(kfs.size());
+  const Mat3 R_ci = T_cm_i.rotationMatrix();
+  for (size_t k = 0; k < kfs.size(); ++k) {
+    const SE3d T_wf_cf = kfs[k].T_cf_wf.inverse();
+    poses[k] = {T_wf_cf.rotationMatrix(), T_wf_cf.translation(), T_wf_cf.rotationMatrix() * R_ci};
+  }
+  return poses;
+}
+
+// estimateTimeOffset's cost of one candidate: the summed squared rotation residual after step 1's
+// gyro bias fit; infinity where the IMU does not cover the keyframes at that offset.
+double rotationCost(const std::vector<ViInitKeyframe>& kfs, const std::vector<Pose>& poses, const ImuBuffer& imu,
+                    const ImuNoise& noise, ImuBias bias, double offset, int iterations) {
+  const int64_t off_ns = sToNs(offset);
+  if (!imu.covers(kfs.front().t_ns + off_ns, kfs.back().t_ns + off_ns)) return std::numeric_limits<double>::infinity();
+  const std::vector<ImuPreintegration> pre = preintegrateAll(kfs, imu, noise, bias, offset);
+  bias.gyro = estimateGyroBias(pre, poses, bias, iterations);
+  double cost = 0.0;
+  for (size_t k = 0; k < pre.size(); ++k) {
+    const SO3d R_ij(Mat3(poses[k].R_wi.transpose() * poses[k + 1].R_wi));
+    cost += (pre[k].corrected(bias).R.inverse() * R_ij).log().squaredNorm();
+  }
+  return cost;
 }
 
 // Whitening of one interval's (dv, dp) rows expressed in W_f axes: rows (vel; pos).
@@ -204,6 +231,36 @@ ViInitResult solveInit(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& 
                        const SE3d& T_cm_i, double offset, const ViInitOptions& opt);
 }  // namespace
 
+double estimateTimeOffset(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& imu, const ImuNoise& noise,
+                          const SE3d& T_cm_i, double offset0, double range_s, const ImuBias& bias0,
+                          int gyro_bias_iterations, double* cost_curvature) {
+  if (cost_curvature) *cost_curvature = 0.0;
+  if (kfs.size() < 3 || !(range_s > 0.0)) return offset0;
+  const std::vector<Pose> poses = posesOf(kfs, T_cm_i);
+  auto cost = [&](double o) { return rotationCost(kfs, poses, imu, noise, bias0, o, gyro_bias_iterations); };
+  // A coarse grid of 11 over the range, then 7 around the best at a fifth of the step, twice.
+  double step = range_s / 5.0, best = offset0, f_best = std::numeric_limits<double>::infinity();
+  for (int round = 0, half = 5; round < 3; ++round, step /= 5.0, half = 3) {
+    const double centre = best;
+    for (int i = -half; i <= half; ++i) {
+      const double o = centre + i * step;
+      const double f = cost(o);
+      if (f < f_best) {
+        f_best = f;
+        best = o;
+      }
+    }
+  }
+  if (!std::isfinite(f_best)) return offset0;
+  step *= 5.0;  // the last round's step: a parabola through the best and its neighbours
+  const double fm = cost(best - step), fp = cost(best + step);
+  const double curv = (fm + fp - 2.0 * f_best) / (step * step);
+  if (!std::isfinite(curv) || !(curv > 0.0)) return best;
+  if (cost_curvature) *cost_curvature = curv;
+  const double shift = (fm - fp) / (2.0 * curv * step);  // vertex offset from best, in seconds
+  return best + std::clamp(shift, -step, step);
+}
+
 ViInitResult initializeVisualInertial(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& imu,
                                       const ImuNoise& noise, const SE3d& T_cm_i, double offset,
                                       const ViInitOptions& opt) {
@@ -270,12 +327,8 @@ ViInitResult solveInit(const std::vector<ViInitKeyframe>& kfs, const ImuBuffer& 
     return res;
   }
 
-  std::vector<Pose> poses(n);
+  const std::vector<Pose> poses = posesOf(kfs, T_cm_i);
   const Mat3 R_ci = T_cm_i.rotationMatrix();
-  for (int k = 0; k < n; ++k) {
-    const SE3d T_wf_cf = kfs[k].T_cf_wf.inverse();
-    poses[k] = {T_wf_cf.rotationMatrix(), T_wf_cf.translation(), T_wf_cf.rotationMatrix() * R_ci};
-  }
   const Vec3 t_ci = T_cm_i.translation();
 
   // Step 1: gyroscope bias, then preintegrate at it.

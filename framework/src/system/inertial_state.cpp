@@ -117,6 +117,13 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
   std::vector<ViInitKeyframe> kfs;
   for (const ViInitKeyframe& k : keyframes)
     if (buffer_.covers(k.t_ns + off, k.t_ns + off)) kfs.push_back(k);
+  // imu.init_time_offset_search_ms: before the initialisation the offset is what the keyframes' rotations
+  // and the gyroscope agree on, searched around the starting one (calibration plus correction) at each
+  // attempt; the gyroscope's rotations used before the initialisation (frame rotations, twists) and the
+  // initialisation then see the IMU at the right time, and the online estimate starts there.
+  if (o_.estimate_time_offset && o_.init_time_offset_search_ms > 0.0 && kfs.size() >= 3)
+    globals_.state.time_offset_s = estimateTimeOffset(kfs, buffer_, sensors_.imu, T_cm_i_,
+                                                      sensors_.camera.time_offset_s, 1e-3 * o_.init_time_offset_search_ms);
   if (static_cast<int>(kfs.size()) < o_.init_min_keyframes) {
     std::ostringstream os;
     os << "waiting for keyframes with IMU data: " << kfs.size() << " < imu.init_min_keyframes "

@@ -22,6 +22,7 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["twist_weight"] = o.twist_weight;
   got["estimate_time_offset"] = o.estimate_time_offset;
   got["time_offset_correction_ms"] = o.time_offset_correction_ms;
+  got["init_time_offset_search_ms"] = o.init_time_offset_search_ms;
   got["frame_twist_from_imu"] = o.frame_twist_from_imu;
   got["smooth_motion_weight"] = o.smooth_motion_weight;
   got["gyro_bias_sigma_before_init_rad_s"] = o.gyro_bias_sigma_before_init_rad_s;

@@ -18,6 +18,10 @@ struct InertialOptions {
   double imu_weight = 1.0;              // alpha of eq. 34
   double twist_weight = 1.0;            // beta of eq. 34
   bool estimate_time_offset = false;    // camera-IMU time offset online (t_imu = t_cam + offset)
+  // With estimate_time_offset: before the initialisation, at each attempt, the offset is searched within
+  // +- this (ms) of the starting one by the rotations alone (estimateTimeOffset, vi_init.h); the online
+  // estimate starts there.
+  double init_time_offset_search_ms = 50.0;
   // Added to the calibration's time offset (what rsvio diagnose measures when the calibration lacks
   // it); with estimate_time_offset the estimate starts there.
   double time_offset_correction_ms = 0.0;

@@ -78,6 +78,20 @@ struct ViInitResult {
   double imu_chi2_max = 0.0;
 };
 
+// The camera-IMU time offset (t_imu = t_cam + offset) that best explains the keyframes' relative
+// rotations by the gyroscope: for each candidate offset the gyroscope is preintegrated between
+// consecutive keyframes, the gyro bias fitted to the rotations (the initialisation's step 1), and the
+// summed squared rotation residual |Log(dR_imu^T R_ij)|^2 taken; candidates on a grid over
+// [offset0 - range_s, offset0 + range_s] at range_s / 5, then around the best at a fifth of that
+// step twice more, and a parabola through the best and its neighbours. Only changes of the rotation
+// rate make the offset visible (at a constant rate every interval's rotation is the same at any
+// offset): *cost_curvature (if given) is the parabola's second derivative in rad^2/s^2, small when
+// the motion does not show the offset. Returns offset0 when the IMU does not cover the keyframes at
+// some candidate. Keyframe times on the camera clock (middle row), poses T_cf_wf.
+double estimateTimeOffset(const std::vector<ViInitKeyframe>& keyframes, const ImuBuffer& imu, const ImuNoise& noise,
+                          const SE3d& T_cm_i, double offset0, double range_s, const ImuBias& bias0 = ImuBias(),
+                          int gyro_bias_iterations = 3, double* cost_curvature = nullptr);
+
 ViInitResult initializeVisualInertial(const std::vector<ViInitKeyframe>& keyframes, const ImuBuffer& imu,
                                       const ImuNoise& noise, const SE3d& T_cm_i, double time_offset_s = 0.0,
                                       const ViInitOptions& options = ViInitOptions());
