@@ -19,7 +19,10 @@
 #   MODES      the runs per seed (default "rsvio_rs gsvio_rs gsvio_gs"); rsviodm_rs and gsviodm_gs are
 #              rs_vio on RS and gs_vio on the twin with imu.dynamic_marginalization=true; rsvio_gs is
 #              rs_vio on the GS twin with a near-zero line delay (0.001 us): the rolling-shutter settings
-#              without a readout, which separates what the readout costs from what the settings cost
+#              without a readout, which separates what the readout costs from what the settings cost;
+#              rsvioto_rsto is rs_vio estimating the camera-IMU time offset (imu.estimate_time_offset, from
+#              0) on the rolling-shutter data simulated with a hidden 15 ms offset (effect.time_offset;
+#              datasets <seq>_rsto_s<seed>), against rsvio_rs: issue 14's time-offset item
 #   SETS       more --set lines for every run, e.g. SETS="imu.init_scale_factor=1.3"
 #   TAG        appended to the run folders (run_<seq>_s<seed>_<mode><TAG>), to keep variants apart
 # Datasets are simulated once into OUT_DIR/<seq>_<rs|gs>_s<seed> and reused (0.5-3 min each on 2
@@ -40,7 +43,9 @@ SEQS=${SEQS:-med}
 DURATION_S=${DURATION_S:-15}
 for seq in $SEQS; do
   for seed in "${SEEDS[@]}"; do
-    for sh in rs gs; do
+    kinds="rs gs"
+    [[ " $MODES " == *"_rsto "* ]] && kinds+=" rsto"
+    for sh in $kinds; do
       data="$OUT/${seq}_${sh}_s$seed"
       [ -f "$data/truth.json" ] && continue
       sim=(--config configs/sim/demo.json --seed "$seed")
@@ -49,6 +54,7 @@ for seq in $SEQS; do
         sim=(--config "configs/sim/seq$seq.json" --seed $((100 * seed + 10#$seq)) --set motion.duration_s="$DURATION_S")
       fi
       [ "$sh" = gs ] && sim+=(--set effects.rolling_shutter=null)
+      [ "$sh" = rsto ] && sim+=(--set effects.time_offset.plugin=effect.time_offset --set effects.time_offset.params.offset_ms=15)
       echo "== simulating ${sim[*]} -> $data"
       "$BIN" -q simulate "${sim[@]}" --out "$data"
     done
@@ -64,6 +70,8 @@ run_one() {  # seq seed mode
     rsvio_gs) cfg=configs/rs_vio.json; data="$OUT/${seq}_gs_s$seed"; sets=(--set shutter.params.line_delay_us=0.001) ;;
     rsviodm_rs) cfg=configs/rs_vio.json; data="$OUT/${seq}_rs_s$seed"
                 sets=(--set shutter.params.line_delay_us=58.94 --set imu.dynamic_marginalization=true) ;;
+    rsvioto_rsto) cfg=configs/rs_vio.json; data="$OUT/${seq}_rsto_s$seed"
+                  sets=(--set shutter.params.line_delay_us=58.94 --set imu.estimate_time_offset=true) ;;
     gsviodm_gs) cfg=configs/gs_vio.json; data="$OUT/${seq}_gs_s$seed"; sets=(--set imu.dynamic_marginalization=true) ;;
     *) echo "acceptance_vio: unknown mode $mode" >&2; return 1 ;;
   esac
@@ -102,11 +110,12 @@ def inf_median(v):
 def mm(v):
     return "fail" if v == float("inf") else "%.1f" % (1e3 * v)
 print()
-print("%-4s %-4s %-10s %7s %7s %9s %10s %7s %8s %8s %7s %5s  %s" % ("seq", "seed", "mode", "status", "frames",
-      "SE3 (mm)", "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "error"))
+print("%-4s %-4s %-12s %7s %7s %9s %10s %7s %8s %8s %7s %5s %7s  %s" % ("seq", "seed", "mode", "status", "frames",
+      "SE3 (mm)", "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "dt (ms)", "error"))
 allv = {m: [] for m in modes}       # SE(3) ATE per run (failed = inf)
 perseq = {}                         # (seq, mode) -> median over the seeds
 scales = []                         # Sim(3) scales of successful rs_vio / gs_vio runs
+offsets = []                        # estimated time offsets (ms) of successful runs on the offset data
 for seq in seqs:
     for mode in modes:
         vals = []
@@ -114,7 +123,7 @@ for seq in seqs:
             base = os.path.join(out, "run_%s_s%s_%s%s" % (seq, seed, mode, tag))
             r = load(os.path.join(base, "report.json"))
             if not r:
-                print("%-4s %-4s %-10s  (no report)" % (seq, seed, mode)); vals.append(float("inf")); continue
+                print("%-4s %-4s %-12s  (no report)" % (seq, seed, mode)); vals.append(float("inf")); continue
             s3 = load(base + ".sim3.json") or {}
             ev = r.get("eval", {})
             vio = r.get("extra", {}).get("vio", {})
@@ -122,7 +131,7 @@ for seq in seqs:
             se3 = ev.get("ate_rmse_m") if metric else None
             sim3 = s3.get("ate_rmse_m")
             scale = s3.get("alignment", {}).get("scale")
-            data = os.path.join(out, "%s_%s_s%s" % (seq, mode[-2:], seed))
+            data = os.path.join(out, "%s_%s_s%s" % (seq, mode.rsplit("_", 1)[1], seed))
             t0 = (load(os.path.join(data, "truth.json")) or {}).get("clocks", {}).get("start_ns", 0) * 1e-9
             ok = r["status"] == "ok"
             vals.append(se3 if ok and se3 is not None else float("inf"))
@@ -130,7 +139,9 @@ for seq in seqs:
                 scales.append((seq, seed, mode, scale))
             init_t = vio.get("initialised_at_s")
             dm = vio.get("dynamic_marginalization")
-            print("%-4s %-4s %-10s %7s %7d %9s %10s %7s %8s %8s %7s %5s  %s" % (
+            if ok and vio.get("time_offset_ms") is not None and mode.endswith("_rsto"):
+                offsets.append(vio["time_offset_ms"])
+            print("%-4s %-4s %-12s %7s %7d %9s %10s %7s %8s %8s %7s %5s %7s  %s" % (
                 seq, seed, mode, r["status"], r.get("frames", 0),
                 "%.1f" % (1e3 * se3) if se3 is not None else "-",
                 "%.1f" % (1e3 * sim3) if sim3 is not None else "-",
@@ -139,6 +150,7 @@ for seq in seqs:
                 "%.3f" % vio["scale_at_initialisation"] if vio.get("initialised") else "-",
                 "%.3f" % vio["scale"] if vio.get("initialised") else "-",
                 "%d/%d" % (dm["switches"], dm["half_resets"]) if dm else "-",
+                "%.2f" % vio["time_offset_ms"] if vio.get("time_offset_ms") is not None else "-",
                 (r.get("error") or "")[:80]))
         allv[mode] += vals
         perseq[(seq, mode)] = inf_median(vals)
@@ -152,12 +164,21 @@ if len(seqs) > 1:
         if "rsvio_rs" in modes and "gsvio_gs" in modes:
             a, b = perseq[(seq, "rsvio_rs")], perseq[(seq, "gsvio_gs")]
             line += "   %s" % ("-" if a == float("inf") or b == float("inf") else "%.2fx" % (a / b))
+        if "rsvioto_rsto" in modes and "rsvio_rs" in modes:
+            a, b = perseq[(seq, "rsvioto_rsto")], perseq[(seq, "rsvio_rs")]
+            line += "   offset/none %s" % ("-" if a == float("inf") or b == float("inf") else "%.2fx" % (a / b))
         print(line)
 med = {m: inf_median(v) for m, v in allv.items()}
 print("medians of the SE(3) ATE over all runs (failed = inf): " + ", ".join("%s %s mm" % (m, mm(v)) for m, v in med.items()))
 print("failed runs: " + ", ".join("%s %d/%d" % (m, sum(x == float("inf") for x in v), len(v)) for m, v in allv.items()))
 if "rsvio_rs" in med and "gsvio_gs" in med:
     print("rs_vio on RS vs gs_vio on the twin %.2fx" % (med["rsvio_rs"] / med["gsvio_gs"]))
+if "rsvioto_rsto" in med and "rsvio_rs" in med:
+    print("rs_vio estimating a hidden 15 ms offset vs rs_vio without one: %.2fx" % (med["rsvioto_rsto"] / med["rsvio_rs"]))
+if offsets:
+    err = sorted(abs(o - 15.0) for o in offsets)
+    print("estimated offsets (truth 15 ms): %d runs, |error| median %.2f ms, max %.2f ms, %d within 1 ms" % (
+        len(err), statistics.median(err), err[-1], sum(e <= 1.0 for e in err)))
 off = [x for x in scales if x[2] != "gsvio_rs" and abs(x[3] - 1.0) > 0.02]
 print("Sim(3) scale of successful rs_vio/gs_vio-on-twin runs: %d of %d within 2 %% of 1%s" % (
     sum(1 for x in scales if x[2] != "gsvio_rs") - len(off), sum(1 for x in scales if x[2] != "gsvio_rs"),
