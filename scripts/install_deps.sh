@@ -3,7 +3,8 @@
 # Run as root (or with sudo available). Nothing is downloaded besides Debian packages.
 set -euo pipefail
 PKGS=(build-essential cmake pkg-config libeigen3-dev libopencv-dev libsuitesparse-dev libvtk9-dev xvfb xauth
-      nlohmann-json3-dev libcli11-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev)
+      nlohmann-json3-dev libcli11-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
+      libpng-dev libjpeg62-turbo-dev)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #ifdef RSVIO_VIZ_HAVE_FREETYPE
 #include <opencv2/freetype.hpp>
 #endif
+
+#include "rsvio/core/error.h"
+#include "rsvio/io/image_file.h"
 
 namespace rsvio::viz::detail {
 
@@ -153,10 +155,10 @@ void Canvas::circle(cv::Point2d p, double radius, Rgb c, bool filled) {
 
 bool Canvas::save(const std::string& path, std::string* why) const {
   try {
-    if (cv::imwrite(path, img_)) return true;
-    if (why) *why = path + ": could not write PNG";
-  } catch (const cv::Exception& e) {
-    if (why) *why = path + ": " + e.what();
+    io::writePng(path, img_, 1);  // zlib level 1: fast, as cv::imwrite's default was
+    return true;
+  } catch (const Error& e) {
+    if (why) *why = e.what();  // "<path>: cannot write PNG: ..."
   }
   return false;
 }

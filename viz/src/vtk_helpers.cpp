@@ -18,10 +18,10 @@
 
 #include <cmath>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/image_file.h"
 
 #ifdef RSVIO_SANITIZE
 #include <dlfcn.h>
@@ -212,7 +212,7 @@ void writePng(vtkRenderWindow* win, const std::string& path, int width, int heig
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
   cv::flip(bgr, bgr, 0);  // VTK's rows start at the bottom
-  if (!cv::imwrite(path, bgr)) throw Error(path + ": could not write PNG");
+  io::writePng(path, bgr, 1);  // zlib level 1: fast, as cv::imwrite's default was; throws Error naming path
 }
 
 void keepGlDriverLoaded() {

@@ -2,11 +2,11 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 
 #include "rsvio/core/error.h"
 #include "rsvio/io/calibration.h"
 #include "rsvio/io/csv.h"
+#include "rsvio/io/image_file.h"
 #include "rsvio/io/trajectory.h"
 
 namespace rsvio::io {
@@ -56,11 +56,10 @@ cv::Mat readVignette(const std::string& path, int expected_width, int expected_h
     throw DataError::at(path, 0, "vignette is not a PNG file (the file does not start with the PNG signature)");
   cv::Mat img;
   try {
-    img = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw DataError::at(path, 0, std::string("cannot decode vignette image: ") + e.what());
+    img = readImage(path);
+  } catch (const ImageError& e) {
+    throw DataError::at(path, 0, "cannot decode vignette image: " + e.reason());
   }
-  if (img.empty()) throw DataError::at(path, 0, "cannot decode vignette image (corrupt or unsupported format)");
   if (img.channels() != 1)
     throw DataError::at(path, 0, "vignette must be a single-channel image, found " +
                                      std::to_string(img.channels()) + " channels");

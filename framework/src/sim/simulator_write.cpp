@@ -4,10 +4,10 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <thread>
 
 #include "rsvio/core/error.h"
+#include "rsvio/io/image_file.h"
 #include "rsvio/sim/euroc_writer.h"
 #include "rsvio/sim/simulator.h"
 
@@ -154,14 +154,13 @@ void Simulator::write(const std::string& dir, const SimProgressFn& progress) {
     std::atomic<bool> failed{false};
     std::exception_ptr error;
     std::mutex mutex;
-    const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, settings_.png_compression};
     auto worker = [&] {
       for (size_t i = next++; i < n && !failed; i = next++) {
         try {
           nlohmann::json ft = nlohmann::json::object();
           const cv::Mat img = renderImage(i, &ft);
           const std::string path = (cam / "data" / (std::to_string(frame_stamps_[i]) + ".png")).string();
-          if (!cv::imwrite(path, img, png)) throw Error(path + ": cannot write image");
+          io::writePng(path, img, settings_.png_compression);
           frame_truth[i] = std::move(ft);
           const size_t d = ++done;
           std::lock_guard<std::mutex> lock(mutex);

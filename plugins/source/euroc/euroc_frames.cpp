@@ -2,13 +2,13 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "dataset_index.h"
 #include "euroc_source.h"
 #include "rsvio/core/error.h"
 #include "rsvio/io/calibration.h"
+#include "rsvio/io/image_file.h"
 
 namespace fs = std::filesystem;
 
@@ -42,11 +42,10 @@ cv::Mat EurocSource::loadRaw(size_t i) const {
                                     "empty, truncated or another format renamed?)");
   cv::Mat img;
   try {
-    img = cv::imread(f.path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw DataError(frameLabel(i) + ": cannot decode image: " + e.what());
+    img = io::readImage(f.path);  // PNG or JPEG, as cv::imread(IMREAD_UNCHANGED)
+  } catch (const io::ImageError& e) {
+    throw DataError(frameLabel(i) + ": cannot read or decode image: " + e.reason());
   }
-  if (img.empty()) throw DataError(frameLabel(i) + ": cannot read or decode image (unreadable or corrupt)");
   if (img.depth() != CV_8U && img.depth() != CV_16U)
     throw DataError(frameLabel(i) + ": unsupported pixel depth (expected 8- or 16-bit)");
   if (img.channels() == 3 || img.channels() == 4) {

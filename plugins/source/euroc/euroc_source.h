@@ -2,7 +2,8 @@
 // and rsvio's simulator - one camera chosen by name. Interface contract: rsvio/interfaces/data_source.h.
 //
 // Layout read (dir = the sequence folder holding mav0/, or mav0/ itself):
-//   mav0/<camera>/data.csv + data/<file>   image index and images (8- or 16-bit, read on demand)
+//   mav0/<camera>/data.csv + data/<file>   image index and images (8-/16-bit PNG or JPEG, rsvio/io/image_file.h;
+//                                          colour converted to grey; read on demand)
 //   mav0/imu0/data.csv                     IMU samples (optional: without it has_imu = false)
 //   calibration, first found unless params.calibration_file names one:
 //     Kalibr camchain: dso/camchain.yaml, camchain*.yaml, dso/*camchain*.yaml
