@@ -95,9 +95,10 @@ TEST(BundleAdjustment, ConvergesFromPerturbedPosesAndDepths) {
 
 // BundleAdjustmentConfig::max_rejected_steps: with no stop on the energy decrease, a converged window
 // keeps proposing steps that do not lower the energy; the limit ends the iterations after that many
-// rejected steps in a row, at the energy the unlimited run also keeps (a rejected step changes nothing).
+// rejected steps in a row, within 0.1 % of the energy the unlimited run reaches (a rejected step
+// changes nothing; the unlimited run differs only where a later step is accepted).
 TEST(BundleAdjustment, StopsAfterTheConfiguredRejectedSteps) {
-  auto run = [](int max_rejected, double* energy) {
+  auto run = [](int max_rejected) {
     TestWindow w(4);
     w.addPoints(0, 300);
     w.addPoints(1, 200, 5);
@@ -109,13 +110,10 @@ TEST(BundleAdjustment, StopsAfterTheConfiguredRejectedSteps) {
     c.max_rejected_steps = max_rejected;
     BundleAdjuster ba(c, w.camera, w.timing, *solver);
     MarginalizationPrior prior;
-    const BundleAdjustmentStats s = ba.optimize(w.window, prior, 16);
-    *energy = s.energy_final;
-    return s;
+    return ba.optimize(w.window, prior, 16);
   };
-  double e_all = 0, e_two = 0;
-  const BundleAdjustmentStats all = run(0, &e_all);
-  const BundleAdjustmentStats two = run(2, &e_two);
+  const BundleAdjustmentStats all = run(0);
+  const BundleAdjustmentStats two = run(2);
   EXPECT_FALSE(all.solver_failed || two.solver_failed);
   EXPECT_EQ(all.iterations, 16);
   ASSERT_GE(all.rejected, 3);  // the unlimited run does reject steps once converged
@@ -123,8 +121,8 @@ TEST(BundleAdjustment, StopsAfterTheConfiguredRejectedSteps) {
   EXPECT_LT(two.iterations, 16);
   EXPECT_GE(two.rejected, 2);
   EXPECT_EQ(two.iterations, two.accepted + two.rejected);
-  EXPECT_LE(e_all, e_two);
-  EXPECT_LT(e_two, 1.001 * e_all);  // it stopped converged, not early
+  EXPECT_LE(all.energy_final, two.energy_final);
+  EXPECT_LT(two.energy_final, 1.001 * all.energy_final);  // it stopped converged, not early
 }
 
 // At the true states, the rolling-shutter projection explains rolling-shutter images clearly better
