@@ -30,6 +30,7 @@
 #include "rsvio/io/calibration.h"
 #include "rsvio/io/csv.h"
 #include "rsvio/io/diagnostics_log.h"
+#include "rsvio/io/image_file.h"
 #include "rsvio/io/ply.h"
 #include "rsvio/io/snapshot.h"
 #include "rsvio/io/states.h"

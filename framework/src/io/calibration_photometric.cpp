@@ -11,16 +11,6 @@
 
 namespace rsvio::io {
 
-bool hasPngSignature(const std::string& path) {
-  static const unsigned char kSig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  std::ifstream in(path, std::ios::binary);
-  unsigned char buf[8] = {};
-  if (!in.read(reinterpret_cast<char*>(buf), 8)) return false;
-  for (int i = 0; i < 8; ++i)
-    if (buf[i] != kSig[i]) return false;
-  return true;
-}
-
 std::vector<float> readInverseResponse(const std::string& path) {
   CsvFormat fmt;
   fmt.delimiter = CsvFormat::Delimiter::kWhitespace;

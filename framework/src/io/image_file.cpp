@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <vector>
 
 // jpeglib.h needs <cstdio> (FILE) before it.
@@ -392,6 +393,12 @@ class PngWriter {
 };
 
 }  // namespace
+
+bool hasPngSignature(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char buf[sizeof(kPngSignature)] = {};
+  return in.read(reinterpret_cast<char*>(buf), sizeof(buf)) && std::memcmp(buf, kPngSignature, sizeof(buf)) == 0;
+}
 
 cv::Mat readImage(const std::string& path) {
   const std::vector<unsigned char> bytes = readFileBytes(path);

@@ -91,7 +91,7 @@ struct BundleAdjustmentConfig {
 struct BundleAdjustmentStats {
   int iterations = 0;              // linearisations after the first
   int accepted = 0;
-  int rejected = 0;                // steps whose energy was not lower (iterations - accepted, less solver failures)
+  int rejected = 0;                // steps whose energy was not lower (= iterations - accepted)
   double energy_initial = 0.0;     // total energy before / after
   double energy_final = 0.0;
   double photometric_energy = 0.0; // inlier photometric energy at the end

@@ -41,8 +41,4 @@ struct ExposureEntry {
 // non-finite or non-positive exposure.
 std::vector<ExposureEntry> readExposureTimes(const std::string& path);
 
-// True when the file starts with the 8-byte PNG signature (a cheap check before decoding, so that a
-// file that is not a PNG gets a clear message instead of a decoder's complaint).
-bool hasPngSignature(const std::string& path);
-
 }  // namespace rsvio::io

@@ -48,6 +48,10 @@ class ImageError : public DataError {
   std::string reason_;
 };
 
+// True when the file starts with the 8-byte PNG signature: a cheap check of a file named .png before
+// decoding, so that another format renamed, an empty or a truncated file gets a message that says so.
+bool hasPngSignature(const std::string& path);
+
 // Reads a PNG or JPEG file with cv::imread(IMREAD_UNCHANGED)'s result (see above). Throws ImageError.
 cv::Mat readImage(const std::string& path);
 
