@@ -232,6 +232,10 @@ ParamTable TrackerOptions::paramTable() {
       paramInt("track_twist_retries", d.twist_retries, 0, 5, "",
                "rolling shutter: a frame lost with its predicted twist is tracked again this many times at most, "
                "with the twist's rotation re-estimated from the pose each attempt reached (0: never)"),
+      paramInt("track_twist_refinements", d.twist_refinements, 0, 5, "",
+               "rolling shutter: a tracked frame is tracked again this many times from the pose it reached, with "
+               "the twist's rotation re-estimated as the rate through that pose (0: never; not when the IMU "
+               "gives the rotation)"),
   };
 }
 
@@ -246,6 +250,7 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.max_rmse = p.getDouble("track_max_rmse");
   o.min_explained_ratio = p.getDouble("track_min_explained_ratio");
   o.twist_retries = static_cast<int>(p.getInt("track_twist_retries"));
+  o.twist_refinements = static_cast<int>(p.getInt("track_twist_refinements"));
   return o;
 }
 

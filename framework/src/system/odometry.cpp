@@ -196,6 +196,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   if (imu_twist) {  // the IMU's twist (InertialOptions::frame_twist_from_imu, InertialState::frameTwist)
     const std::vector<SE3d> g = tracking->guesses(frame.t_ns);
     inertial->frameTwist(ref, frame.t_ns, g.empty() ? ref.state.T_c_w : g.front(), &info.twist);
+    info.twist_measured = true;
   }
   if (rolling && inertial) info.w_dot = inertial->readoutWDot(frame.t_ns);
   info.affine_guess = record->frames().empty() ? ref.state.affine : record->frames().back().affine;

@@ -10,7 +10,8 @@ Tracking::Tracking(const TrackerOptions& options, const CameraModel& camera, con
     : tracker_(std::make_unique<FrameTracker>(options, camera, timing)),
       motion_(std::move(motion)),
       timing_(timing),
-      twist_retries_(options.twist_retries) {}
+      twist_retries_(options.twist_retries),
+      twist_refinements_(options.twist_refinements) {}
 
 TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_in, bool* ok) {
   auto good = [](const TrackResult& r) { return r.ok() && r.T_c_w.translation().allFinite(); };
@@ -34,6 +35,18 @@ TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_i
   if (!*ok) {
     ++lost_in_row_;
     return r;
+  }
+  // Twist refinement (rolling shutter, see tracking.h): the predicted rotation lags; the rate through
+  // the pose just found, extrapolated to the frame's time, is nearer the truth, and the frame is tracked
+  // again with it from that pose. A refinement that does not track keeps the result before it. Needs two
+  // frames of history (the rate through one interval would lag as the prediction does).
+  const bool refine = timing_.dtDv() != 0.0 && !info.twist_measured && history_.size() >= 2;
+  for (int k = 0; refine && k < twist_refinements_; ++k) {
+    const SE3d T = r.T_c_w;
+    info.twist.tail<3>() = rotationRateAt(info.t_ns, &T);
+    const TrackResult rk = tracker_->track(pyr, info, {T});
+    if (!good(rk)) break;
+    r = rk;
   }
   lost_in_row_ = 0;
   if (std::isnan(first_rmse_)) first_rmse_ = r.rmse;

@@ -38,6 +38,10 @@ class Tracking {
   // times, from the pose the last attempt reached and with the twist's rotation rotationRateAt(t, that
   // pose) (translation kept). A frame whose rotation rate changed suddenly is otherwise lost, as the
   // fast preset's were within 2 s (docs/rolling_shutter.md, "Twist retries").
+  // A tracked frame is tracked again TrackerOptions::twist_refinements times (rolling shutter, two
+  // frames of history, info.twist_measured false), from its pose and with the rotation
+  // rotationRateAt(t, that pose): the predicted rotation is the last interval's mean rate, 75 ms old at
+  // the frame, and its error turns into pose error (docs/rolling_shutter.md, "Twist refinement").
   TrackResult track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok);
   // Tracks a frame from given guesses; counters and history untouched (frames of the monocular start).
   TrackResult trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses);
@@ -72,6 +76,7 @@ class Tracking {
   std::vector<MotionState> history_;
   RowTiming timing_;
   int twist_retries_ = 0;
+  int twist_refinements_ = 0;
   int lost_in_row_ = 0;
   long twist_rescues_ = 0;
   double first_rmse_ = std::nan("");

@@ -20,6 +20,7 @@
 #include "rsvio/photometric/pixel_selector.h"
 #include "rsvio/plugin/host.h"
 #include "rsvio/sim/simulator.h"
+#include "framework/src/system/tracking.h"
 
 namespace rsvio {
 namespace {
@@ -187,6 +188,47 @@ TEST(SimTracking, RollingShutterImagesWithTheTwistGiven) {
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_LT(transErr(r.T_c_w, truth), 0.01);
   EXPECT_LT(rotErr(r.T_c_w, truth), 0.004);
+}
+
+// Twist refinement (Tracking::track, TrackerOptions::twist_refinements): frames after a keyframe of
+// tiny_rs tracked as a run tracks them, each from the last pose with the last frame interval's rate as
+// the twist's rotation (the translation given true here, to look at the rotation alone), and each
+// frame's pose goes into the history the next prediction is made from. Measured (frames 13-18): mean
+// error 31.9 mm and 0.36 deg plain, 8.5 mm and 0.10 deg with one refinement. Shown failing once: a
+// refinement with the rate extrapolated from the history alone (without the pose just found) gave
+// 54.8 mm.
+TEST(SimTracking, RollingShutterTwistRefinementLowersThePoseErrorOfALaggingRate) {
+  const SimSequence& s = sequence("tiny_rs.json");
+  ASSERT_GT(s.timing.line_delay_s, 0.0);
+  const size_t k = 12;
+  const std::vector<int64_t>& stamps = s.sim->frameStamps();
+  auto run = [&](int refinements, double* trans, double* rot) {
+    TrackerOptions o;
+    o.twist_refinements = refinements;
+    Tracking tracking(o, *s.camera, s.timing, {});
+    tracking.setReference(reference(s, k));
+    tracking.pushHistory(stamps[k - 1], s.pose(k - 1), false);
+    tracking.pushHistory(stamps[k], s.pose(k), true);
+    *trans = *rot = 0.0;
+    for (size_t i = k + 1; i <= k + 6; ++i) {
+      TrackingFrame info;
+      info.t_ns = stamps[i];
+      info.twist << s.twist(i).head<3>(), tracking.velocityEstimate().tail<3>();
+      bool ok = false;
+      const TrackResult r = tracking.track(*s.pyramid(i), info, &ok);
+      ASSERT_TRUE(ok) << "frame " << i << ": " << r.reason;
+      *trans += transErr(r.T_c_w, s.pose(i)) / 6.0;
+      *rot += rotErr(r.T_c_w, s.pose(i)) / 6.0;
+      tracking.pushHistory(stamps[i], r.T_c_w, false);
+    }
+  };
+  double t0 = 0, r0 = 0, t1 = 0, r1 = 0;
+  run(0, &t0, &r0);
+  run(1, &t1, &r1);
+  if (getenv("FE_VERBOSE"))
+    printf("mean pose error: plain %.2f mm %.4f deg, refined %.2f mm %.4f deg\n", 1e3 * t0, r0 * 180 / M_PI, 1e3 * t1,
+           r1 * 180 / M_PI);
+  EXPECT_LT(t1, 0.7 * t0);
 }
 
 TEST(SimTracking, CandidateDepthsConvergeWithinTheirIntervals) {

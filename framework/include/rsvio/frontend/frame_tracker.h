@@ -89,6 +89,10 @@ struct TrackerOptions {
   // time with the twist's rotation re-estimated from the pose the last attempt reached (Odometry's
   // track(); the tracker itself holds the twist it is given).
   int twist_retries = 2;
+  // Rolling shutter: a tracked frame is tracked again this many times from the pose it reached, with the
+  // twist's rotation re-estimated as the rate through that pose (Odometry's track(); skipped when the
+  // rotation is measured, TrackingFrame::twist_measured). docs/rolling_shutter.md, "Twist refinement".
+  int twist_refinements = 1;
 
   static ParamTable paramTable();                   // keys track_* (see frontend_options.h)
   // Reads the track_* keys; `residual` is left for the caller (ResidualOptions::fromParams).
@@ -118,6 +122,7 @@ struct TrackingReference {
 struct TrackingFrame {
   int64_t t_ns = 0;
   Vec6 twist = Vec6::Zero();            // kept fixed (prior or previous frame)
+  bool twist_measured = false;          // its rotation is the gyroscope's: Tracking does not refine it
   Vec3 w_dot = Vec3::Zero();            // RsFrame::w_dot, kept fixed (the gyroscope's; zero without it)
   double exposure_ms = std::numeric_limits<double>::quiet_NaN();
   AffineBrightness affine_guess;        // usually the previous frame's
