@@ -90,7 +90,7 @@ struct TrackerOptions {
   // track(); the tracker itself holds the twist it is given).
   int twist_retries = 2;
   // Rolling shutter: a tracked frame is tracked again this many times from the pose it reached, with the
-  // twist's rotation re-estimated as the rate through that pose (Odometry's track(); skipped when the
+  // twist's rotation re-estimated as the rate through that pose (Tracking::track; skipped when the
   // rotation is measured, TrackingFrame::twist_measured). docs/rolling_shutter.md, "Twist refinement".
   int twist_refinements = 1;
 
