@@ -479,7 +479,7 @@ void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundle
         const ActivePoint& p = *m.points[static_cast<size_t>(i)];
         if (!(p.idepth > 0.0) || !std::isfinite(p.idepth)) continue;  // projectRollingShutter skips it
         const Keyframe& h = *p.host;
-        m.host_points[static_cast<size_t>(i)] = rsHostPoint(ex[static_cast<size_t>(h.index)], h.state.twist,
+        m.host_points[static_cast<size_t>(i)] = rsHostPoint(ex[static_cast<size_t>(h.index)],
                                                             m.timing.rowTime(p.v), p.bearing, p.idepth, true, h.w_dot);
       }
     });

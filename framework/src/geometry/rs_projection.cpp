@@ -27,21 +27,6 @@ Mat36 dLeftAction(const Vec3& p) {
   return J;
 }
 
-// [I, -[p]x] Jl(d) for SE3's left Jacobian Jl(d) = [J, Q; 0, J]: [J, Q - [p]x J], without the
-// 3x6 by 6x6 product. d = 0 (a global shutter) gives [I, -[p]x] exactly.
-Mat36 dLeftActionTimesJl(const Vec3& p, const Vec6& d) {
-  Mat36 M;
-  if (d.isZero(0.0)) {
-    M.leftCols<3>().setIdentity();
-    M.rightCols<3>() = -SO3d::hat(p);
-    return M;
-  }
-  const Mat6 Jl = SE3d::leftJacobian(d);
-  M.leftCols<3>() = Jl.topLeftCorner<3, 3>();
-  M.rightCols<3>() = Jl.topRightCorner<3, 3>() - SO3d::hat(p) * Jl.bottomRightCorner<3, 3>();
-  return M;
-}
-
 // Left-multiplies a 2xK Jacobian by M = (I - a e_v^T)^-1 = [1, a_x / (1 - a_y); 0, 1 / (1 - a_y)].
 template <class Derived>
 void applyImplicitRow(Eigen::MatrixBase<Derived>& A, const Vec2& a) {
@@ -139,9 +124,9 @@ void solveWorldPoints(const CameraModel& camera, const RowTiming& timing, const 
     if (t == 0.0)
       r.d_uv_d_xi.setZero();
     else if (acc)
-      r.d_uv_d_xi = (Jc[i] * A[i]) * dLeftActionTimesJl(Pxi[i], target.xi * t) * t;
+      r.d_uv_d_xi = (Jc[i] * A[i]) * ex.dLeftActionTimesJl(t, Pxi[i]) * t;
     else
-      r.d_uv_d_xi = Jc[i] * dLeftActionTimesJl(P[i], target.xi * t) * t;
+      r.d_uv_d_xi = Jc[i] * ex.dLeftActionTimesJl(t, P[i]) * t;
     r.d_uv_d_X = JR * target.T_c_w0.rotationMatrix();
     // The row of the solution is uv.y (equal to the iterate within tolerance; for a global shutter the
     // iterate stays at y0 while the pixel's row is uv.y).
@@ -164,7 +149,7 @@ void projectRollingShutter(const CameraModel& camera, const RowTiming& timing, c
   solveWorldPoints(camera, timing, target, X_w, ptrs, options);
 }
 
-RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, const Vec3& bearing_h, double rho,
+RsHostPoint rsHostPoint(const TwistExp& ex_h, double t_h, const Vec3& bearing_h, double rho,
                         bool jacobians, const Vec3& w_dot_h) {
   RsHostPoint h;
   Vec3 p;
@@ -176,7 +161,7 @@ RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, cons
     if (jacobians) h.dZ_dt_acc = -h.E * ra.g(t_h).cross(Vec3(bearing_h / rho));
   }
   h.Z = h.E * Vec3(bearing_h / rho) + p;
-  if (jacobians && t_h != 0.0) h.dZ = dLeftActionTimesJl(h.Z, -xi_h * t_h);
+  if (jacobians && t_h != 0.0) h.dZ = ex_h.dLeftActionTimesJl(-t_h, h.Z);
   return h;
 }
 
@@ -214,7 +199,7 @@ void projectHostPoints(const CameraModel& camera, const RowTiming& timing, const
     o.d_uv_d_xi_h.setZero();
     o.d_uv_d_idepth.setZero();
     if (!host_points)
-      computed[s] = rsHostPoint(ex_h, host.xi, timing.rowTime(v_h[i]), bearing_h.col(i), rho, options.jacobians,
+      computed[s] = rsHostPoint(ex_h, timing.rowTime(v_h[i]), bearing_h.col(i), rho, options.jacobians,
                                 host.w_dot);
     X.col(static_cast<Eigen::Index>(idx.size())) = T_w_h0 * hp[s].Z;
     idx.push_back(i);

@@ -45,7 +45,8 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   if (cfg.contains("photometric") && cfg.at("photometric").is_object())
     for (auto it = cfg.at("photometric").begin(); it != cfg.at("photometric").end(); ++it) {
       if (it->is_null()) continue;
-      photometric.push_back(makeSlot<PhotometricModel>(host, cfg, "photometric." + it.key()));
+      photometric_keys.push_back("photometric." + it.key());
+      photometric.push_back(makeSlot<PhotometricModel>(host, cfg, photometric_keys.back()));
       photometric.back()->setSensors(sensors);
       photometric_ptrs.push_back(photometric.back().get());
     }
@@ -120,6 +121,14 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
   }
+  // A photometric model's own parameters (PhotometricModel::numParams, e.g. photometric.response's
+  // gamma in mode "estimate") are not optimised by this back end: say so instead of running silently
+  // as if the model were there.
+  for (size_t i = 0; i < photometric_ptrs.size(); ++i)
+    if (const int n = photometric_ptrs[i]->numParams(); n > 0)
+      record->addWarning(photometric_keys[i] + ": its " + std::to_string(n) +
+                         " parameter(s) are not estimated by the back end; the model leaves the images as "
+                         "they are (a calibrated mode applies it)");
 }
 
 // Visual-inertial: the initialisation at each new keyframe until it succeeds, on the keyframe poses of

@@ -53,6 +53,7 @@ struct Odometry::Impl {
   std::unique_ptr<SolverBackend> solver;
   std::vector<std::unique_ptr<PhotometricModel>> photometric;
   std::vector<const PhotometricModel*> photometric_ptrs;
+  std::vector<std::string> photometric_keys;  // their config slots ("photometric.<name>"), same order
   std::vector<std::unique_ptr<MotionPrior>> motion;
   RowTiming timing;             // the shutter's; its line delay follows the window's when estimated
   double line_delay_start_s = 0.0;

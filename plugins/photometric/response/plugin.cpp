@@ -10,7 +10,8 @@ namespace {
 ParamTable table() {
   return {
       paramEnum("mode", "auto", {"auto", "calibrated", "estimate"},
-                "auto: the dataset's inverse response (pcalib.txt) when given, else estimate a gamma online"),
+                "auto: the dataset's inverse response (pcalib.txt) when given, else a gamma the back end does not "
+                "estimate yet (the images are left as they are; the run warns)"),
       paramDouble("initial_gamma", 1.0, 0.1, 10.0, "", "initial g of the estimated response G(B) = 255 (B/255)^g"),
   };
 }
@@ -18,7 +19,7 @@ ParamTable table() {
 void registerAll(PluginRegistrar& r) {
   r.add<PhotometricModel>(
       {"photometric.response", PluginKind::Photometric, "1.0.0",
-       "Camera response: applies the calibrated inverse response, or estimates a gamma online", table(), ""},
+       "Camera response: applies the calibrated inverse response (a gamma to estimate is not used by the back end yet)", table(), ""},
       [](const Params& p) {
         const std::string m = p.getString("mode");
         const ResponseModel::Mode mode = m == "calibrated" ? ResponseModel::Mode::Calibrated

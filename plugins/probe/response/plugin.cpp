@@ -50,7 +50,9 @@ class ResponseProbe : public DiagnosticProbe {
     r.config_line = line.str();
     std::ostringstream ex;
     ex.precision(3);
-    ex << "residual bends with intensity (z = " << s.z << ", curvature " << s.beta << ")";
+    ex << "residual bends with intensity (z = " << s.z << ", curvature " << s.beta
+       << "); the back end does not estimate the response yet, so the line records the model and leaves the "
+          "images as they are: a calibrated inverse response (pcalib.txt, mode calibrated) applies it";
     r.explanation = ex.str();
     r.details = probe::toJson(s);
     r.details["gamma_suggested"] = g;

@@ -48,6 +48,9 @@ using Mat26 = Eigen::Matrix<double, 2, 6>;
 struct TwistExp {
   Mat3 W = Mat3::Zero(), W2 = Mat3::Zero();
   Vec3 v = Vec3::Zero(), Wv = Vec3::Zero(), WWv = Vec3::Zero();
+  // For SE3's Q(xi t) (rsvio/lie/se3.h calcQ with U = t [v]x, W = t [w]x), U = [v]x:
+  // S1 = WU + UW, S2 = WUW, S3 = WWU + UWW - 3 WUW, S4 = WUWW + WWUW.
+  Mat3 U = Mat3::Zero(), S1 = Mat3::Zero(), S2 = Mat3::Zero(), S3 = Mat3::Zero(), S4 = Mat3::Zero();
   double theta = 0.0;
   bool zero = true;
   explicit TwistExp(const Vec6& xi) {
@@ -59,6 +62,34 @@ struct TwistExp {
     W2 = w * w.transpose() - (theta * theta) * Mat3::Identity();
     Wv = w.cross(v);
     WWv = w.cross(Wv);
+    U = SO3d::hat(v);
+    const Mat3 WU = W * U, UW = U * W;
+    S1 = WU + UW;
+    S2 = WU * W;
+    S3 = W * WU + UW * W - 3.0 * S2;
+    S4 = S2 * W + W * S2;
+  }
+  // [I, -[p]x] Jl(xi t) = [J, Q - [p]x J] for SE3's left Jacobian Jl = [J, Q; 0, J] at the row time t
+  // (the rolling-shutter Jacobian's factor, rs_projection.cpp), from the products above:
+  //   J = I + t b W + t^2 c W^2,  Q = t/2 U + c t^2 S1 + c t^3 S2 + q2 t^3 S3 + q3 t^4 S4,
+  // b, c, q2, q3 the coefficients of rsvio/lie at |w t|. The same as SE3d::leftJacobian(xi t) up to
+  // rounding (tests/framework/geometry); zero twist or t = 0: [I, -[p]x] exactly.
+  Eigen::Matrix<double, 3, 6> dLeftActionTimesJl(double t, const Vec3& p) const {
+    Eigen::Matrix<double, 3, 6> M;
+    const Mat3 P = SO3d::hat(p);
+    if (zero || t == 0.0) {
+      M.leftCols<3>().setIdentity();
+      M.rightCols<3>() = -P;
+      return M;
+    }
+    const double phi = std::abs(theta * t);
+    const double c = lie::thetaMinusSinOverTheta3(phi), t2 = t * t, t3 = t2 * t;
+    const Mat3 J = Mat3::Identity() + (t * lie::oneMinusCosOverTheta2(phi)) * W + (t2 * c) * W2;
+    const Mat3 Q = (0.5 * t) * U + (c * t2) * S1 + (c * t3) * S2 + (lie::se3QCoeff2(phi) * t3) * S3 +
+                   (lie::se3QCoeff3(phi) * t2 * t2) * S4;
+    M.leftCols<3>() = J;
+    M.rightCols<3>() = Q - P * J;
+    return M;
   }
   // The global-shutter case (zero twist or t = 0) is exactly the identity.
   void at(double t, Mat3& R, Vec3& p) const {
@@ -212,8 +243,8 @@ struct RsHostPoint {
   Eigen::Matrix<double, 3, 6> dZ = Eigen::Matrix<double, 3, 6>::Zero();
   Vec3 dZ_dt_acc = Vec3::Zero();
 };
-// ex_h = TwistExp(xi_h); rho > 0 and finite (the caller skips the others); w_dot_h the host's RsFrame::w_dot.
-RsHostPoint rsHostPoint(const TwistExp& ex_h, const Vec6& xi_h, double t_h, const Vec3& bearing_h, double rho,
+// ex_h = TwistExp(the host twist xi_h); rho > 0 and finite (the caller skips the others); w_dot_h the host's RsFrame::w_dot.
+RsHostPoint rsHostPoint(const TwistExp& ex_h, double t_h, const Vec3& bearing_h, double rho,
                         bool jacobians, const Vec3& w_dot_h = Vec3::Zero());
 // As above, with the host points given (host_points[i] = rsHostPoint(...) of column i for every column
 // with a valid inverse depth; the others are not read).
