@@ -140,5 +140,25 @@ TEST(Odometry, NoiseAfterAGoodStartEndsInTrackingLost) {
   EXPECT_LE(r.frames, 40);   // detected within a few frames, not at the end
 }
 
+// A photometric model whose own parameters the back end does not estimate (photometric.response in
+// mode "estimate": numParams() 1) is named in a warning; the calibrated-or-nothing models are not.
+TEST(Odometry, PhotometricModelWhoseParametersAreNotEstimatedIsNamedInAWarning) {
+  const std::string data = simDataset("tiny_gs");
+  PluginHost& host = test::contractHost();
+  auto warningsOf = [&](const nlohmann::json& cfg) {
+    auto source = host.create<DataSource>("source.euroc", slotParams(cfg, "source"));
+    source->open(data);
+    const Odometry odo(cfg, host, source->sensors());
+    std::string all;
+    for (const std::string& w : odo.warnings()) all += w + "\n";
+    return all;
+  };
+  const std::string with = warningsOf(runConfig(
+      "gs_vo", {"photometric.response.plugin=photometric.response", "photometric.response.params.mode=estimate"}));
+  EXPECT_NE(with.find("photometric.response: its 1 parameter(s) are not estimated"), std::string::npos) << with;
+  const std::string without = warningsOf(runConfig("gs_vo"));
+  EXPECT_EQ(without.find("not estimated"), std::string::npos) << without;
+}
+
 }  // namespace
 }  // namespace rsvio
