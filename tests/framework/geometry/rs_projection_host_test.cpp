@@ -177,7 +177,7 @@ TEST_F(RsHostProjectionTest, GivenHostPointsGiveTheSameBitsAsComputedOnes) {
     B.col(i) = b;
     v_h[i] = px.y();
     rho[i] = (i % 9 == 4) ? 0.0 : 0.2 + 0.03 * i;
-    if (rho[i] > 0) hp[static_cast<size_t>(i)] = rsHostPoint(ex, host_.xi, timing_.rowTime(v_h[i]), b, rho[i], true);
+    if (rho[i] > 0) hp[static_cast<size_t>(i)] = rsHostPoint(ex, timing_.rowTime(v_h[i]), b, rho[i], true);
   }
   std::vector<RsHostProjection> computed, given;
   projectRollingShutter(*cam_, timing_, host_, target_, B, v_h, rho, computed);
@@ -196,7 +196,7 @@ TEST_F(RsHostProjectionTest, GivenHostPointsGiveTheSameBitsAsComputedOnes) {
   }
   EXPECT_GT(n_valid, n / 2);
   // A host part of another host twist is not the same projection (the given one is what is used).
-  hp[1] = rsHostPoint(TwistExp(Vec6::Zero()), Vec6::Zero(), timing_.rowTime(v_h[1]), B.col(1), rho[1], true);
+  hp[1] = rsHostPoint(TwistExp(Vec6::Zero()), timing_.rowTime(v_h[1]), B.col(1), rho[1], true);
   projectRollingShutter(*cam_, timing_, host_, target_, B, v_h, rho, hp, given);
   EXPECT_GT((given[1].uv - computed[1].uv).norm(), 1e-3);
 }

@@ -311,5 +311,30 @@ TEST(TwistExpTest, IsTheSe3ExponentialAlongTheRows) {
   EXPECT_EQ(p, Vec3::Zero());
 }
 
+// The rolling-shutter Jacobian's factor [I, -[p]x] Jl(xi t) from the per-twist products: SE3's left
+// Jacobian at xi t, each 3x3 block against its own scale (J, and Q - [p]x J), over the rows' times and
+// beyond, the series region (|w t| small) included; zero twist or t = 0 exactly [I, -[p]x].
+TEST(TwistExpTest, LeftActionTimesLeftJacobianIsSe3sAlongTheRows) {
+  const Vec6 twists[3] = {(Vec6() << 0.6, -0.2, 0.3, 0.4, -0.5, 0.2).finished(),
+                          (Vec6() << 1.5, 0.7, -2.0, 0.9, 1.1, -0.6).finished(),
+                          (Vec6() << 0.3, 0.1, 0.0, 1e-9, 0.0, 0.0).finished()};
+  const Vec3 p(0.4, -1.2, 5.0);
+  Eigen::Matrix<double, 3, 6> A;
+  A.leftCols<3>().setIdentity();
+  A.rightCols<3>() = -SO3d::hat(p);
+  for (const Vec6& xi : twists) {
+    const TwistExp ex(xi);
+    for (double t : {-0.015, -1e-4, 3e-6, 0.012, 0.8, 2.0}) {
+      const Eigen::Matrix<double, 3, 6> ref = A * SE3d::leftJacobian(xi * t);
+      const Eigen::Matrix<double, 3, 6> got = ex.dLeftActionTimesJl(t, p);
+      EXPECT_LT((got.leftCols<3>() - ref.leftCols<3>()).norm(), 1e-14 * ref.leftCols<3>().norm()) << "J, t " << t;
+      EXPECT_LT((got.rightCols<3>() - ref.rightCols<3>()).norm(), 1e-13 * ref.rightCols<3>().norm())
+          << "Q - [p]x J, t " << t;
+    }
+  }
+  EXPECT_EQ(TwistExp(Vec6::Zero()).dLeftActionTimesJl(0.01, p), A);
+  EXPECT_EQ(TwistExp(twists[0]).dLeftActionTimesJl(0.0, p), A);
+}
+
 }  // namespace
 }  // namespace rsvio::test
