@@ -9,9 +9,10 @@
 //   k = x (N - 1) / 255. numParams() = 0, predict() is the identity. Apply before photometric.vignette.
 // - Estimated (no calibration, or mode "estimate"): a gamma-like response on the 0..255 scale,
 //     G(B) = 255 (B / 255)^g,  g > 0 (g = 1: linear),
-//   with g estimated online through numParams()/params()/setParams(); correct() leaves the image as
-//   it is and predict(B) = G(B) with d G / d B = g G / B and d G / d g = G ln(B / 255)
-//   (B <= 0 predicts 0 with zero derivatives).
+//   with g offered for estimation through numParams()/params()/setParams(); correct() leaves the image
+//   as it is and predict(B) = G(B) with d G / d B = g G / B and d G / d g = G ln(B / 255)
+//   (B <= 0 predicts 0 with zero derivatives). The back end does not call these yet: the run warns
+//   (Odometry) and g stays at its initial value.
 #pragma once
 #include <cmath>
 #include <string>

@@ -243,7 +243,8 @@ struct RsHostPoint {
   Eigen::Matrix<double, 3, 6> dZ = Eigen::Matrix<double, 3, 6>::Zero();
   Vec3 dZ_dt_acc = Vec3::Zero();
 };
-// ex_h = TwistExp(the host twist xi_h); rho > 0 and finite (the caller skips the others); w_dot_h the host's RsFrame::w_dot.
+// ex_h = TwistExp(the host twist xi_h); rho > 0 and finite (the caller skips the others); w_dot_h the
+// host's RsFrame::w_dot.
 RsHostPoint rsHostPoint(const TwistExp& ex_h, double t_h, const Vec3& bearing_h, double rho,
                         bool jacobians, const Vec3& w_dot_h = Vec3::Zero());
 // As above, with the host points given (host_points[i] = rsHostPoint(...) of column i for every column
