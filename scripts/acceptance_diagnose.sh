@@ -103,7 +103,7 @@ one() {
     [ "$round" != 1 ] && label="$seed.$round"
     printf "%-16s %4s %-16s %-44s %12s %12s %8s %s\n" "$effect" "$label" "$verdict" "$top" "$ate_b" "$ate_a" "$ratio" "$ev" | tee -a "$TABLE"
     [ "$verdict" = none ] && break
-    [ "$round" = 1 ] && [ "$(rounds "$effect")" = 1 ] && break
+    [ "$round" -ge "$(rounds "$effect")" ] && break
     run="$next"
   done
 }

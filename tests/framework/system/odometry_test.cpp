@@ -141,7 +141,8 @@ TEST(Odometry, NoiseAfterAGoodStartEndsInTrackingLost) {
 }
 
 // A photometric model whose own parameters the back end does not estimate (photometric.response in
-// mode "estimate": numParams() 1) is named in a warning; the calibrated-or-nothing models are not.
+// mode "estimate": numParams() 1) is named in a warning; a config without such a model (gs_vo: affine
+// brightness only) gets no such warning.
 TEST(Odometry, PhotometricModelWhoseParametersAreNotEstimatedIsNamedInAWarning) {
   const std::string data = simDataset("tiny_gs");
   PluginHost& host = test::contractHost();
