@@ -308,6 +308,29 @@ void fillStats(const Linearization& L, BundleAdjustmentStats& s) {
 }
 
 }  // namespace
+// The small-step test (BundleAdjustmentConfig::min_step_rad, min_step_idepth): DSO's test on the pose
+// steps' RMS over the window, the rotation in rad and the translation times the points' mean inverse
+// depth before the step (so both are angles whatever the monocular scale; pose step = tangent
+// (upsilon; omega) of the left perturbation at StateLayout::photometricOffset(k)), and the points' RMS
+// inverse-depth step relative to that mean.
+bool stepIsSmall(const KeyframeList& window, const std::vector<double>& idepth_before, const Eigen::VectorXd& dx_c,
+                 const Eigen::VectorXd& dx_p, const BundleAdjustmentConfig& cfg) {
+  if (window.empty() || idepth_before.empty()) return false;
+  double rot2 = 0.0, trans2 = 0.0;
+  for (const auto& kf : window) {
+    const auto d = dx_c.segment<6>(cfg.layout.photometricOffset(kf->index) + StateLayout::kPose);
+    trans2 += d.head<3>().squaredNorm();
+    rot2 += d.tail<3>().squaredNorm();
+  }
+  const double n = static_cast<double>(window.size());
+  double mean_idepth = 0.0;
+  for (double r : idepth_before) mean_idepth += std::abs(r);
+  mean_idepth /= static_cast<double>(idepth_before.size());
+  const double idepth_rms = std::sqrt(dx_p.squaredNorm() / static_cast<double>(dx_p.size()));
+  return std::sqrt(rot2 / n) < cfg.min_step_rad && std::sqrt(trans2 / n) * mean_idepth < cfg.min_step_rad &&
+         idepth_rms < cfg.min_step_idepth * mean_idepth;
+}
+
 }  // namespace ba
 
 BundleAdjuster::BundleAdjuster(const BundleAdjustmentConfig& config, const CameraModel& camera,
@@ -415,6 +438,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
     ++s.iterations;
     const double e_new = ba::photometricEnergy(m, m.trial) + ba::cameraTermsEnergy(m, config_, terms_);
     if (e_new < e) {
+      const bool small = config_.min_step_rad > 0.0 && ba::stepIsSmall(window, idepth_backup, dx_c, dx_p, config_);
       ba::accumulatePhotometric(m, m.trial, config_, false);
       ba::addCameraTerms(m, m.trial, config_, terms_);
       std::swap(m.cur, m.trial);
@@ -423,6 +447,10 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
       const double rel = (e - e_new) / std::max(e, 1e-300);
       e = e_new;
       lambda *= 0.5;
+      if (small) {
+        s.small_step = true;
+        break;
+      }
       if (rel < config_.step_threshold) break;
     } else {
       for (auto& kf : window) kf->state = kf->backup;

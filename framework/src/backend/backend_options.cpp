@@ -25,6 +25,13 @@ ParamTable backendParamTable() {
       paramInt("max_rejected_steps", d.max_rejected_steps, 0, 100, "",
                "stop iterating after this many rejected Levenberg-Marquardt steps in a row (0: no such stop; "
                "docs/performance.md, Rejected steps)"),
+      paramDouble("min_step_rad", d.min_step_rad, 0.0, 1.0, "rad",
+                  "stop iterating after an accepted step whose RMS keyframe rotation and RMS translation x mean "
+                  "inverse depth are both below this (DSO's test, 6e-5 there) and whose inverse-depth steps are "
+                  "below min_step_idepth (0: no such stop; docs/performance.md, Small steps)"),
+      paramDouble("min_step_idepth", d.min_step_idepth, 0.0, 1.0, "",
+                  "the small-step stop's bound on the points' RMS inverse-depth step, relative to their mean "
+                  "inverse depth"),
       paramDouble("marg_weight_factor", d.marg_weight_factor, 0.0, 1.0, "",
                   "factor on the information of marginalised points (DSO: 0.25)"),
       paramBool("marg_project_scale", d.marg_project_scale,
@@ -97,6 +104,8 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.lambda_initial = p.getDouble("lambda_initial");
   o.step_threshold = p.getDouble("step_threshold");
   o.max_rejected_steps = static_cast<int>(p.getInt("max_rejected_steps"));
+  o.min_step_rad = p.getDouble("min_step_rad");
+  o.min_step_idepth = p.getDouble("min_step_idepth");
   o.marg_weight_factor = p.getDouble("marg_weight_factor");
   o.marg_project_scale = p.getBool("marg_project_scale");
   o.min_idepth_hessian_marg = p.getDouble("min_idepth_hessian_marg");

@@ -125,6 +125,44 @@ TEST(BundleAdjustment, StopsAfterTheConfiguredRejectedSteps) {
   EXPECT_LT(two.energy_final, 1.001 * all.energy_final);  // it stopped converged, not early
 }
 
+// BundleAdjustmentConfig::min_step_rad / min_step_idepth (the small-step stop): with no stop on the
+// energy decrease, the window iterates to the limit; with the stop it ends at the first accepted step
+// whose pose and inverse-depth increments are below the thresholds, after the large first steps (the
+// start is 0.02 rad / 0.01 and 5 % in inverse depth off), converged: within 0.1 % of the energy the
+// unlimited run reaches. With the pose test always passed (min_step_rad 1), the depths alone hold the
+// iterations until their steps fall below 1 % of the mean inverse depth: more than one accepted step.
+TEST(BundleAdjustment, StopsAfterAnAcceptedStepBelowTheIncrementThreshold) {
+  auto run = [](double min_step_rad, double min_step_idepth = 0.01) {
+    TestWindow w(4);
+    w.addPoints(0, 300);
+    w.addPoints(1, 200, 5);
+    w.window[0]->gauge = true;
+    perturb(w, 0.02, 0.01, 0.05, 7);
+    auto solver = dense();
+    BundleAdjustmentConfig c = gsConfig();
+    c.step_threshold = 0.0;
+    c.min_step_rad = min_step_rad;
+    c.min_step_idepth = min_step_idepth;
+    BundleAdjuster ba(c, w.camera, w.timing, *solver);
+    MarginalizationPrior prior;
+    return ba.optimize(w.window, prior, 16);
+  };
+  const BundleAdjustmentStats all = run(0.0);
+  const BundleAdjustmentStats small = run(6e-5);
+  EXPECT_FALSE(all.solver_failed || small.solver_failed);
+  EXPECT_EQ(all.iterations, 16);
+  EXPECT_FALSE(all.small_step);
+  EXPECT_TRUE(small.small_step);
+  EXPECT_GE(small.accepted, 2);  // not on the first, large steps
+  EXPECT_LT(small.iterations, 16);
+  EXPECT_LE(all.energy_final, small.energy_final);
+  EXPECT_LT(small.energy_final, 1.001 * all.energy_final);
+  const BundleAdjustmentStats depths = run(1.0);
+  EXPECT_TRUE(depths.small_step);
+  EXPECT_GE(depths.accepted, 2);
+  EXPECT_LT(depths.energy_final, 1.01 * all.energy_final);
+}
+
 // At the true states, the rolling-shutter projection explains rolling-shutter images clearly better
 // than the same states seen through a global-shutter model (twists ignored).
 TEST(BundleAdjustment, RollingShutterEnergyExplainsRollingShutterImages) {

@@ -311,6 +311,8 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["lambda_initial"] = o.lambda_initial;
   got["step_threshold"] = o.step_threshold;
   got["max_rejected_steps"] = o.max_rejected_steps;
+  got["min_step_rad"] = o.min_step_rad;
+  got["min_step_idepth"] = o.min_step_idepth;
   got["marg_weight_factor"] = o.marg_weight_factor;
   got["marg_project_scale"] = o.marg_project_scale;
   got["min_idepth_hessian_marg"] = o.min_idepth_hessian_marg;

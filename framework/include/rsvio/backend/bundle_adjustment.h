@@ -74,6 +74,16 @@ struct BundleAdjustmentConfig {
   // end them). A rejected step's relative damping (1e-4 x 4^k) barely changes the next step, so
   // further tries mostly repeat it (docs/performance.md, "Rejected steps").
   int max_rejected_steps = 0;
+  // The small-step stop: after an accepted step, stop when the RMS over the window's keyframes of the
+  // pose step's rotation (rad) and of its translation times the points' mean inverse depth (rad: the
+  // translation seen at the mean depth) are both below min_step_rad (DSO's test in doStepFromBackup;
+  // its setting_thOptIterations 1.2 gives 6e-5), and the points' RMS inverse-depth step is below
+  // min_step_idepth times their mean inverse depth (DSO does not test the depths; without that test one
+  // of nine gs_vo runs at 800 points ended 0.47 m off, docs/performance.md "Small steps"). min_step_rad
+  // 0: no such stop.
+  // Affine, twist and inertial steps are not tested.
+  double min_step_rad = 0.0;
+  double min_step_idepth = 0.01;
   double twist_regularization = 1e-6;
   // Monocular runs: remove the scale direction (a null direction of the photometric energy) from every
   // step, so the damping cannot move the scale (DSO orthogonalises its steps the same way). Off when
@@ -92,6 +102,7 @@ struct BundleAdjustmentStats {
   int iterations = 0;              // linearisations after the first
   int accepted = 0;
   int rejected = 0;                // steps whose energy was not lower (= iterations - accepted)
+  bool small_step = false;         // the iterations ended on min_step_rad
   double energy_initial = 0.0;     // total energy before / after
   double energy_final = 0.0;
   double photometric_energy = 0.0; // inlier photometric energy at the end
