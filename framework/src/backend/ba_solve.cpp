@@ -308,6 +308,7 @@ void fillStats(const Linearization& L, BundleAdjustmentStats& s) {
 }
 
 }  // namespace
+
 // The small-step test (BundleAdjustmentConfig::min_step_rad, min_step_idepth): DSO's test on the pose
 // steps' RMS over the window, the rotation in rad and the translation times the points' mean inverse
 // depth before the step (so both are angles whatever the monocular scale; pose step = tangent

@@ -80,8 +80,7 @@ struct BundleAdjustmentConfig {
   // its setting_thOptIterations 1.2 gives 6e-5), and the points' RMS inverse-depth step is below
   // min_step_idepth times their mean inverse depth (DSO does not test the depths; without that test one
   // of nine gs_vo runs at 800 points ended 0.47 m off, docs/performance.md "Small steps"). min_step_rad
-  // 0: no such stop.
-  // Affine, twist and inertial steps are not tested.
+  // 0: no such stop. Affine, twist, inertial and global (line delay, T_Wm_Wf) steps are not tested.
   double min_step_rad = 0.0;
   double min_step_idepth = 0.01;
   double twist_regularization = 1e-6;
