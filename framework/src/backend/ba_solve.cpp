@@ -307,8 +307,6 @@ void fillStats(const Linearization& L, BundleAdjustmentStats& s) {
   s.num_obs = L.num_in + L.num_oob + L.num_outlier;
 }
 
-}  // namespace
-
 // The small-step test (BundleAdjustmentConfig::min_step_rad, min_step_idepth): DSO's test on the pose
 // steps' RMS over the window, the rotation in rad and the translation times the points' mean inverse
 // depth before the step (so both are angles whatever the monocular scale; pose step = tangent
@@ -331,6 +329,8 @@ bool stepIsSmall(const KeyframeList& window, const std::vector<double>& idepth_b
   return std::sqrt(rot2 / n) < cfg.min_step_rad && std::sqrt(trans2 / n) * mean_idepth < cfg.min_step_rad &&
          idepth_rms < cfg.min_step_idepth * mean_idepth;
 }
+
+}  // namespace
 
 }  // namespace ba
 

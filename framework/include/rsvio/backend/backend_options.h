@@ -27,7 +27,7 @@ struct BackendOptions {
   int max_rejected_steps = 0;         // stop after this many rejected steps in a row (0: no such stop)
   double min_step_rad = 0.0;          // stop after an accepted step whose pose steps are this small (DSO: 6e-5;
                                       // 0: no such stop) ...
-  double min_step_idepth = 0.01;      // ... and whose inverse-depth steps are this small, relative
+  double min_step_idepth = 0.01;      // ... and whose RMS inverse-depth step is below this x their mean
   double marg_weight_factor = 0.25;   // Hessian factor of marginalised points (DSO setting_margWeightFac)
   bool marg_project_scale = true;     // project the scale direction at x_lin off marginalised points' terms
   double min_idepth_hessian_marg = 50.0;  // a point leaving the window goes into the prior above this (DSO)
