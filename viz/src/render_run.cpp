@@ -145,6 +145,7 @@ ResidualMapInput residualMapInput(const DiagnosticsLog& log) {
   in.image_height = log.height;
   in.obs.reserve(log.observations.size());
   for (const auto& o : log.observations) {
+    if (!(o.weight > 0.f)) continue;  // an outlier the window dropped (weight 0): not a residual it fitted
     in.obs.push_back(ResidualObservation{o.t_ns, o.u, o.v, o.row, o.residual, o.weight});
   }
   return in;

@@ -12,7 +12,7 @@ namespace rsvio {
 
 namespace {
 constexpr char kMagic[8] = {'R', 'S', 'V', 'I', 'O', 'D', 'G', '1'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: ObservationRow::host_radius
 
 struct Header {
   char magic[8];

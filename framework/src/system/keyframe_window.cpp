@@ -336,6 +336,10 @@ void KeyframeWindow::removeOutliersAndMarginalizePoints(Keyframe& newest, Window
       bool newest_oob = false;
       for (const ActiveObservation& o : p.obs)
         if (o.target == &newest && o.state == ObsState::kOob) newest_oob = true;
+      // An outlier leaves here (the diagnostics log keeps it, with weight 0: probe.vignetting needs the
+      // large residuals that the outlier threshold cuts off).
+      for (const ActiveObservation& o : p.obs)
+        if (o.state == ObsState::kOutlier) sink.observationLeaves(p, o);
       p.obs.erase(std::remove_if(p.obs.begin(), p.obs.end(),
                                  [](const ActiveObservation& o) { return o.state != ObsState::kIn; }),
                   p.obs.end());

@@ -50,7 +50,8 @@ namespace rsvio {
 class WindowSink {
  public:
   virtual ~WindowSink() = default;
-  // An observation of p at its last linearisation (called for inliers only).
+  // An observation of p at its last linearisation: an inlier when it leaves the window, an outlier when
+  // it is removed (never one outside the image).
   virtual void observationLeaves(const ActivePoint& p, const ActiveObservation& o) = 0;
   // A point that leaves the window with its information kept (marginalised, or at the end of the run).
   virtual void pointLeaves(const ActivePoint& p) = 0;

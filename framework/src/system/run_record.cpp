@@ -124,7 +124,7 @@ Vec6 RunRecord::observedTwist(Keyframe& kf) const {
 }
 
 void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation& o) {
-  if (!(o.state == ObsState::kIn)) return;
+  if (o.state == ObsState::kOob) return;
   const Keyframe& host = *p.host;
   Keyframe& target = *o.target;
   ObservationRow r;
@@ -137,6 +137,7 @@ void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation&
   const CameraCalibration& c = camera_.calibration();
   const double half_diag = 0.5 * std::hypot(c.width, c.height);
   r.radius = static_cast<float>(std::hypot(o.u - c.intrinsics[2], o.v - c.intrinsics[3]) / half_diag);
+  r.host_radius = static_cast<float>(std::hypot(p.u - c.intrinsics[2], p.v - c.intrinsics[3]) / half_diag);
   r.intensity = p.pattern.color[kPatternCentre];
   r.grad_u = o.grad_u;
   r.grad_v = o.grad_v;
@@ -155,7 +156,7 @@ void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation&
     r.vel_v = static_cast<float>(vel.y());
   }
   r.residual = o.mean_residual;
-  r.weight = o.mean_weight;
+  r.weight = o.state == ObsState::kIn ? o.mean_weight : 0.f;  // an outlier: weight 0
   const double exp_ratio =
       (host.exposure_ms > 0 && target.exposure_ms > 0) ? target.exposure_ms / host.exposure_ms : 1.0;
   r.exposure_ratio =

@@ -4,6 +4,7 @@
 // tests/apps/diagnose/.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -21,7 +22,9 @@ enum class Effect { None, RollingShutter, Exposure, Vignetting };
 
 // 30 keyframes, each the target of 5 hosts, 150 points per pair. Each keyframe has its own pixel
 // velocity field (a rotation-like flow), shared by all its observations.
-DiagnosticsLog syntheticLog(Effect effect, unsigned seed) {
+// `applied`: a vignette polynomial (k1, k2, k3) the run divided the images by (photometric.vignette in
+// mode fixed), so that the residuals carry what it left.
+DiagnosticsLog syntheticLog(Effect effect, unsigned seed, const std::array<double, 3>& applied = {0.0, 0.0, 0.0}) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 2.0);
   std::uniform_real_distribution<double> U(0.0, 1.0);
@@ -62,9 +65,16 @@ DiagnosticsLog syntheticLog(Effect effect, unsigned seed) {
         } else if (effect == Effect::Exposure) {
           r += (gain[f] / gain[h] - 1.0) * o.intensity;
         } else if (effect == Effect::Vignetting) {
-          // The host saw the point at a radius of its own (uncorrelated here).
+          // The host saw the point at a radius of its own (uncorrelated here); the simulator's default
+          // vignette (corner at half the centre).
           const double rho_h = U(rng);
-          r += o.intensity * (-0.4) * (o.radius * o.radius - rho_h * rho_h);
+          o.host_radius = static_cast<float>(rho_h);
+          const auto V = [&](double rho) {
+            const double q = rho * rho;
+            return (1.0 - 0.3 * q - 0.15 * q * q - 0.05 * q * q * q) /
+                   (1.0 + q * (applied[0] + q * (applied[1] + q * applied[2])));
+          };
+          r += o.intensity * (V(o.radius) / V(rho_h) - 1.0);
         }
         o.residual = static_cast<float>(r);
         o.weight = 1.0f;
@@ -128,8 +138,38 @@ TEST(Probes, ExposureSignatureNamesExposure) {
 TEST(Probes, VignettingSignatureNamesVignettingWithANegativeK1) {
   expectWinner(Effect::Vignetting, "probe.vignetting", "photometric.vignette.params.mode=fixed");
   const auto r = evaluateAll(syntheticLog(Effect::Vignetting, 7), kGlobalNoAffine).at("probe.vignetting");
-  const double k1 = r.details.at("k1_one_step").get<double>();
-  EXPECT_NEAR(k1, -0.4, 0.08);  // host radius uncorrelated here: the one-step estimate is unbiased
+  // The suggested polynomial is the fit with the host radius: the corner's fall-off and the curve.
+  EXPECT_EQ(r.details.at("fit_params").get<int>(), 3);
+  EXPECT_NEAR(r.details.at("corner_ratio").get<double>(), 0.5, 0.03);
+  const auto k = r.details.at("k_fitted");
+  for (double rho : {0.25, 0.5, 0.75, 1.0}) {
+    const double q = rho * rho;
+    const double fitted = 1.0 + q * (k[0].get<double>() + q * (k[1].get<double>() + q * k[2].get<double>()));
+    EXPECT_NEAR(fitted, 1.0 - 0.3 * q - 0.15 * q * q - 0.05 * q * q * q, 0.02) << "rho " << rho;
+  }
+  EXPECT_NE(r.config_line.find("initial=[-0."), std::string::npos) << r.config_line;
+}
+
+// A run that applied a fixed polynomial (the probe's own suggestion, too weak here: corner at 80 %) is
+// still tested, and the suggestion is the product: the whole fall-off again.
+TEST(Probes, VignettingLeftByAFixedPolynomialIsRefinedToTheWholeFallOff) {
+  const std::array<double, 3> applied = {-0.2, 0.0, 0.0};
+  nlohmann::json cfg = kGlobalNoAffine;
+  cfg["photometric"]["vignette"] = {{"plugin", "photometric.vignette"},
+                                    {"params", {{"mode", "fixed"}, {"initial", {-0.2, 0.0, 0.0}}}}};
+  const auto r = test::makePlugin<DiagnosticProbe>("probe.vignetting")->evaluate(
+      ProbeInput{syntheticLog(Effect::Vignetting, 7, applied), cfg});
+  ASSERT_TRUE(r.applicable) << r.explanation;
+  EXPECT_GT(r.score, 1.0) << r.explanation;
+  EXPECT_NEAR(r.details.at("corner_ratio").get<double>(), 0.5, 0.03) << r.explanation;
+  EXPECT_NEAR(r.details.at("k_residual")[0].get<double>() + r.details.at("k_residual")[1].get<double>() +
+                  r.details.at("k_residual")[2].get<double>() + 1.0,
+              0.5 / 0.8, 0.03);  // what the run's polynomial left at the corner
+  // Any other mode models the effect.
+  cfg["photometric"]["vignette"]["params"]["mode"] = "estimate";
+  EXPECT_FALSE(test::makePlugin<DiagnosticProbe>("probe.vignetting")
+                   ->evaluate(ProbeInput{syntheticLog(Effect::Vignetting, 7, applied), cfg})
+                   .applicable);
 }
 
 TEST(Probes, AModelledEffectIsNotApplicable) {

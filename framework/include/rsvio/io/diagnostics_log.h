@@ -1,17 +1,19 @@
 // The diagnostics log (diagnostics.bin): what `rsvio diagnose` needs from a run, compact and binary.
 //
 // One ObservationRow per point observation at its final linearisation (when the observation leaves the
-// window: marginalised or at the end of the run), one ImuRow per IMU factor (keyframe pair).
+// window: marginalised or at the end of the run; an outlier when the window drops it, with weight 0),
+// one ImuRow per IMU factor (keyframe pair).
 // Fields (float32 unless stated):
 //   t_ns (int64)          capture time of the target frame's row y0, camera clock
 //   frame, host (int32)   target and host frame indices (sequence positions)
 //   u, v                  projected raw pixel in the target (the pattern centre)
 //   row                   raw row minus y0 (v - y0): where a rolling shutter shows
 //   radius                distance from the principal point, normalised by the half diagonal (vignetting)
+//   host_radius           the same for the point's pixel in its host keyframe (version 2)
 //   intensity             host intensity at the point (response, exposure)
 //   grad_u, grad_v        target image gradient at (u, v)
 //   vel_u, vel_v          pixel velocity in the target [px/s] from the frame's twist (d uv/dt)
-//   residual, weight      mean pattern residual and its robust weight
+//   residual, weight      mean pattern residual and its robust weight (0: an outlier)
 //   exposure_ratio        exp(a_target - a_host) when affine brightness is estimated, else 1
 // File layout: magic "RSVIODG1", uint32 version, uint32 sizeof(ObservationRow), uint32 sizeof(ImuRow),
 // uint64 n_obs, uint64 n_imu, then the rows, little-endian as on x86-64 / aarch64.
@@ -35,6 +37,7 @@ struct ObservationRow {
   float u = 0, v = 0;
   float row = 0;
   float radius = 0;
+  float host_radius = 0;
   float intensity = 0;
   float grad_u = 0, grad_v = 0;
   float vel_u = 0, vel_v = 0;
