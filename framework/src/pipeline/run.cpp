@@ -339,6 +339,7 @@ RunResult runPipeline(const RunRequest& request, PluginHost& host) {
       }
     }
     if (const nlohmann::json sh = odo.shutterReport(); !sh.is_null()) report.extra["shutter"] = sh;
+    if (const nlohmann::json ph = odo.photometricReport(); !ph.is_null()) report.extra["photometric"] = ph;
     for (const auto& w : odo.warnings()) report.warnings.push_back(w);
 
     writeOutputs(odo, request.out_dir, streams, report.warnings);

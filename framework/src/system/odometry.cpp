@@ -127,7 +127,10 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   // gamma in mode "estimate") are not optimised by this back end: say so instead of running silently
   // as if the model were there.
   for (size_t i = 0; i < photometric_ptrs.size(); ++i)
-    if (const int n = photometric_ptrs[i]->numParams(); n > 0)
+    if (photometric_ptrs[i]->estimatesOnline()) photometric_online.push_back(i);
+  record->keepRowsForPhotometric(!photometric_online.empty());
+  for (size_t i = 0; i < photometric_ptrs.size(); ++i)
+    if (const int n = photometric_ptrs[i]->numParams(); n > 0 && !photometric_ptrs[i]->estimatesOnline())
       record->addWarning(photometric_keys[i] + ": its " + std::to_string(n) +
                          " parameter(s) are not estimated by the back end; the model leaves the images as "
                          "they are (a calibrated mode applies it)");
@@ -326,7 +329,46 @@ void Odometry::Impl::makeKeyframe(int64_t frame_index, int64_t t_ns, double expo
     ScopedStage st(record->stages(), "marginalise");
     for (Keyframe* f : flagged) window->marginalizeKeyframe(f, *record);
   }
+  refinePhotometric(frame_index);
   checkDivergence();
+}
+
+// Online photometric estimation by alternation (interfaces/photometric.h): the rows of observations
+// whose host and target were both corrected with the current parameters, once a model has enough.
+// Rows that mix an earlier correction are dropped; a refinement applies from the next frame on. The
+// fits see every row kept since the last change: without a change they are fitted again with more.
+void Odometry::Impl::refinePhotometric(int64_t frame_index) {
+  if (photometric_online.empty()) return;
+  std::vector<ObservationRow>& rows = record->photometricRows();
+  const int64_t since = photometric_since;
+  rows.erase(std::remove_if(rows.begin(), rows.end(),
+                            [since](const ObservationRow& r) { return r.frame < since || r.host < since; }),
+             rows.end());
+  bool changed = false;
+  size_t most = 0;
+  for (size_t i : photometric_online) {
+    PhotometricModel& m = *photometric[i];
+    most = std::max(most, m.minRowsForRefine());
+    if (rows.size() < m.minRowsForRefine()) continue;
+    std::string note;
+    ScopedStage st(record->stages(), "photometric");
+    if (m.refineFromResiduals(rows, &note)) {
+      changed = true;
+      const Eigen::VectorXd p = m.params();
+      photometric_updates.push_back({{"slot", photometric_keys[i]},
+                                     {"frame", frame_index},
+                                     {"params", std::vector<double>(p.data(), p.data() + p.size())},
+                                     {"note", note}});
+    }
+  }
+  // Without a change the rows stay, so the next fit has more of them (the oldest half goes beyond ten
+  // times the largest minimum).
+  if (changed) {
+    rows.clear();
+    photometric_since = frame_index + 1;
+  } else if (rows.size() > 10 * most) {
+    rows.erase(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(rows.size() / 2));
+  }
 }
 
 void Odometry::Impl::syncLineDelay() {
@@ -562,6 +604,18 @@ nlohmann::json Odometry::inertialReport() const {
   }
   j["time_offset_estimated"] = m.inertial->options().estimate_time_offset;
   j["time_offset_ms"] = m.inertial->timeOffset() * 1e3;
+  return j;
+}
+nlohmann::json Odometry::photometricReport() const {
+  const Impl& m = *impl_;
+  if (m.photometric_online.empty()) return nullptr;
+  nlohmann::json j;
+  for (size_t i : m.photometric_online) {
+    const Eigen::VectorXd p = m.photometric[i]->params();
+    j[m.photometric_keys[i]] = {{"estimated_online", true},
+                                {"params", std::vector<double>(p.data(), p.data() + p.size())}};
+  }
+  j["updates"] = m.photometric_updates;
   return j;
 }
 nlohmann::json Odometry::shutterReport() const {

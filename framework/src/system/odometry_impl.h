@@ -54,6 +54,11 @@ struct Odometry::Impl {
   std::vector<std::unique_ptr<PhotometricModel>> photometric;
   std::vector<const PhotometricModel*> photometric_ptrs;
   std::vector<std::string> photometric_keys;  // their config slots ("photometric.<name>"), same order
+  // Photometric models estimated online (indices into photometric), the first frame corrected with
+  // their current parameters, and what each refinement changed (report.json "photometric").
+  std::vector<size_t> photometric_online;
+  int64_t photometric_since = 0;
+  nlohmann::json photometric_updates = nlohmann::json::array();
   std::vector<std::unique_ptr<MotionPrior>> motion;
   RowTiming timing;             // the shutter's; its line delay follows the window's when estimated
   double line_delay_start_s = 0.0;
@@ -78,6 +83,9 @@ struct Odometry::Impl {
   void makeKeyframe(int64_t frame_index, int64_t t_ns, double exposure_ms, std::shared_ptr<const ImagePyramid> pyr,
                     const SE3d& T_c_w, const AffineBrightness& affine, const Vec6* twist_start = nullptr);
   void checkDivergence();
+  // After a keyframe: hands the online photometric models the rows of images corrected with their
+  // current parameters (PhotometricModel::refineFromResiduals).
+  void refinePhotometric(int64_t frame_index);
   // An estimated line delay: the window's current value to the timing the tracker and record use.
   void syncLineDelay();
   void tryInertialInitialisation();

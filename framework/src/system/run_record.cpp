@@ -162,6 +162,7 @@ void RunRecord::observationLeaves(const ActivePoint& p, const ActiveObservation&
   r.exposure_ratio =
       static_cast<float>(estimate_affine_ ? exp_ratio * std::exp(target.state.affine.a - host.state.affine.a) : 1.0);
   diag_.observations.push_back(r);
+  if (keep_photometric_) photometric_rows_.push_back(r);
 }
 
 void RunRecord::pointLeaves(const ActivePoint& p) {

@@ -105,6 +105,10 @@ class RunRecord : public WindowSink {
   const DiagnosticsLog& diagnostics() const { return diag_; }
   // Moves the observation rows out (appended to *rows); the log keeps its header fields and IMU rows.
   void takeObservations(std::vector<ObservationRow>* rows);
+  // A photometric model estimated online (PhotometricModel::estimatesOnline): every observation row
+  // is also kept here until the back end hands them over (Odometry::Impl::refinePhotometric).
+  void keepRowsForPhotometric(bool on) { keep_photometric_ = on; }
+  std::vector<ObservationRow>& photometricRows() { return photometric_rows_; }
   // Moves the map points that left the window out (appended to *points), as points() maps them with
   // the records there are when they are taken (points taken before the initialisation stay in W_f;
   // those of a keyframe that left in the settling second take the current scale when no settled
@@ -156,6 +160,8 @@ class RunRecord : public WindowSink {
   void toMetric(std::vector<MapPoint>* points) const;
   RxSO3d currentTransform() const { return globals_->state.T_wm_wf; }
   DiagnosticsLog diag_;
+  bool keep_photometric_ = false;
+  std::vector<ObservationRow> photometric_rows_;
   StageTimes stages_;
   std::vector<std::string> warnings_;
 };

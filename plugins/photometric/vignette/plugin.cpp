@@ -12,8 +12,12 @@ ParamTable table() {
       paramEnum("mode", "auto", {"auto", "calibrated", "estimate", "fixed"},
                 "auto: the dataset's vignette.png when given, else estimate a radial polynomial online; "
                 "fixed: divide by the polynomial `initial` as a calibration"),
-      paramDouble("min_value", 0.05, 1e-3, 1.0, "", "calibrated vignette values are clamped to this before dividing"),
-      paramArray("initial", {0.0, 0.0, 0.0}, 3, "", "initial v1 v2 v3 of V(r) = 1 + v1 r^2 + v2 r^4 + v3 r^6"),
+      paramDouble("min_value", 0.05, 1e-3, 1.0, "", "vignette values are clamped to this before dividing"),
+      paramArray("initial", {0.0, 0.0, 0.0}, 3, "", "v1 v2 v3 of V(r) = 1 + v1 r^2 + v2 r^4 + v3 r^6 to start from (estimate) or to divide by (fixed)"),
+      paramInt("min_rows", 3000, 100, 100000000, "",
+               "estimate: residuals (observations that left the window) needed before each refinement"),
+      paramDouble("min_gain", 0.05, 0.0, 1.0, "",
+                  "estimate: a refinement is applied when it explains at least this fraction of the residual energy"),
   };
 }
 
@@ -30,7 +34,8 @@ void registerAll(PluginRegistrar& r) {
         const std::vector<double> v = p.getArray("initial");
         const std::string where = p.where().empty() ? "photometric.vignette" : p.where();
         return std::make_unique<VignetteModel>(mode, p.getDouble("min_value"), Eigen::Vector3d(v[0], v[1], v[2]),
-                                               where);
+                                               where, static_cast<size_t>(p.getInt("min_rows")),
+                                               p.getDouble("min_gain"));
       });
 }
 

@@ -142,7 +142,7 @@ TEST(Odometry, NoiseAfterAGoodStartEndsInTrackingLost) {
 
 // A photometric model whose own parameters the back end does not estimate (photometric.response in
 // mode "estimate": numParams() 1) is named in a warning; a config without such a model (gs_vo: affine
-// brightness only) gets no such warning.
+// brightness only) or with one estimated online (photometric.vignette) gets no such warning.
 TEST(Odometry, PhotometricModelWhoseParametersAreNotEstimatedIsNamedInAWarning) {
   const std::string data = simDataset("tiny_gs");
   PluginHost& host = test::contractHost();
@@ -159,6 +159,10 @@ TEST(Odometry, PhotometricModelWhoseParametersAreNotEstimatedIsNamedInAWarning) 
   EXPECT_NE(with.find("photometric.response: its 1 parameter(s) are not estimated"), std::string::npos) << with;
   const std::string without = warningsOf(runConfig("gs_vo"));
   EXPECT_EQ(without.find("not estimated"), std::string::npos) << without;
+  // photometric.vignette without a calibration is estimated online (PhotometricModel::estimatesOnline).
+  const std::string vignette = warningsOf(runConfig(
+      "gs_vo", {"photometric.vignette.plugin=photometric.vignette", "photometric.vignette.params.mode=estimate"}));
+  EXPECT_EQ(vignette.find("not estimated"), std::string::npos) << vignette;
 }
 
 }  // namespace

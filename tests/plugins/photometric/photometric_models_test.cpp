@@ -3,9 +3,13 @@
 // through the plugin host.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include "plugins/photometric/response/response_model.h"
 #include "plugins/photometric/vignette/vignette_model.h"
 #include "rsvio/config/validate.h"
+#include "rsvio/photometric/vignette_fit.h"
 #include "rsvio/plugin/host.h"
 #include "support/numeric_jacobian.h"
 
@@ -43,34 +47,86 @@ TEST(VignetteModel, CalibratedDividesByTheVignette) {
   EXPECT_DOUBLE_EQ(dv, 1.0);
 }
 
-TEST(VignetteModel, EstimatedPolynomialAndItsDerivatives) {
-  VignetteModel m(VignetteModel::Mode::Auto, 0.05, Eigen::Vector3d(-0.3, 0.1, -0.05));
+// Residual rows of images corrected with `applied` while the truth is `truth` (interfaces/photometric.h,
+// rsvio/photometric/vignette_fit.h): r = I (W(rho_t) / W(rho_h) - 1), W = truth / applied, each pair
+// with a gain and offset of its own; radii normalised by the half diagonal, as the log's.
+std::vector<ObservationRow> vignetteRows(const Eigen::Vector3d& truth, const Eigen::Vector3d& applied,
+                                         double to_model_rho, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 1.5);
+  const auto W = [&](double rho) { return vignetteValue(truth, rho) / vignetteValue(applied, rho); };
+  std::vector<ObservationRow> rows;
+  for (int pair = 0; pair < 40; ++pair) {
+    const double gain = 0.9 + 0.2 * U(rng), offset = 10.0 * (U(rng) - 0.5);
+    for (int k = 0; k < 100; ++k) {
+      ObservationRow o;
+      o.frame = 10 + pair;
+      o.host = 5 + pair;
+      const double rt = U(rng), rh = U(rng);  // model radii
+      o.radius = static_cast<float>(rt / to_model_rho);
+      o.host_radius = static_cast<float>(rh / to_model_rho);
+      o.intensity = static_cast<float>(30.0 + 200.0 * U(rng));
+      o.residual = static_cast<float>(gain * o.intensity * W(rt) / W(rh) + offset - o.intensity + noise(rng));
+      o.weight = k % 10 == 0 ? 0.f : 1.f;  // some dropped as outliers
+      rows.push_back(o);
+    }
+  }
+  return rows;
+}
+
+TEST(VignetteModel, EstimatedOnlineDividesByThePolynomialAndRefinesItFromResiduals) {
+  const Eigen::Vector3d initial(-0.1, 0.0, 0.0), truth(-0.3, -0.15, -0.05);
+  VignetteModel m(VignetteModel::Mode::Auto, 0.05, initial, "photometric.vignette", /*min_rows=*/1000);
   m.setSensors(sensors());
   EXPECT_FALSE(m.isCalibrated());
+  EXPECT_TRUE(m.estimatesOnline());
   ASSERT_EQ(m.numParams(), 3);
+  EXPECT_EQ(m.minRowsForRefine(), 1000u);
   EXPECT_DOUBLE_EQ(m.radius(Vec2(19.5, 14.5)), 0.0);
   EXPECT_DOUBLE_EQ(m.radius(Vec2(0, 0)), 1.0);  // farthest corner
   cv::Mat img(30, 40, CV_32F, cv::Scalar(60.0));
   m.correct(img, frame());
-  EXPECT_FLOAT_EQ(img.at<float>(0, 0), 60.f);  // estimated: images untouched
-  const Vec2 uv(5.0, 27.0);
-  const double value = 80.0;
-  double d_value = 0;
-  Eigen::VectorXd d_params;
-  const double out = m.predict(value, uv, &d_value, &d_params);
-  const double r = m.radius(uv);
-  EXPECT_NEAR(out, value * (1 - 0.3 * r * r + 0.1 * std::pow(r, 4) - 0.05 * std::pow(r, 6)), 1e-12);
-  const Eigen::MatrixXd num_p = test::numericJacobian(
-      [&](const Eigen::VectorXd& p) {
-        VignetteModel mm = m;
-        mm.setParams(p);
-        return mm.predict(value, uv, nullptr, nullptr);
-      },
-      Eigen::VectorXd(m.params()), test::vectorPlus, 3);
-  EXPECT_JACOBIAN_NEAR(d_params.transpose(), num_p, 1e-7);
-  const Eigen::MatrixXd num_v =
-      test::numericJacobian([&](double x) { return m.predict(x, uv, nullptr, nullptr); }, value, test::vectorPlus, 1);
-  EXPECT_NEAR(d_value, num_v(0, 0), 1e-7);
+  EXPECT_FLOAT_EQ(img.at<float>(0, 0), static_cast<float>(60.0 / 0.9));  // divided by V(1) = 0.9
+  EXPECT_FLOAT_EQ(img.at<float>(14, 19), static_cast<float>(60.0 / m.vignette(Vec2(19, 14))));
+  double dv = 0;
+  EXPECT_DOUBLE_EQ(m.predict(7.0, Vec2(1, 2), &dv, nullptr), 7.0);  // the images carry the correction
+  EXPECT_DOUBLE_EQ(dv, 1.0);
+
+  // The rows' radii (half diagonal 25 px) against the model's (farthest corner, 24.3 px).
+  const double to_model = 0.5 * std::hypot(40.0, 30.0) / std::hypot(19.5, 14.5);
+  std::string note;
+  ASSERT_TRUE(m.refineFromResiduals(vignetteRows(truth, initial, to_model, 1), &note));
+  EXPECT_FALSE(note.empty());
+  EXPECT_EQ(m.updates(), 1);
+  const Eigen::Vector3d k = m.params();
+  for (double rho : {0.25, 0.5, 0.75, 1.0})
+    EXPECT_NEAR(vignetteValue(k, rho), vignetteValue(truth, rho), 0.02) << "rho " << rho;
+  // setParams (and a refinement) changes what correct() divides by.
+  cv::Mat img2(30, 40, CV_32F, cv::Scalar(60.0));
+  m.correct(img2, frame());
+  EXPECT_NEAR(img2.at<float>(0, 0), 60.0 / vignetteValue(k, 1.0), 1e-3);
+  // Residuals with nothing left (only noise and pair gains) change nothing; nor do too few rows.
+  EXPECT_FALSE(m.refineFromResiduals(vignetteRows(truth, truth, to_model, 2), &note));
+  std::vector<ObservationRow> few = vignetteRows(truth, initial, to_model, 3);
+  few.resize(900);
+  EXPECT_FALSE(m.refineFromResiduals(few, &note));
+  EXPECT_EQ(m.updates(), 1);
+  EXPECT_EQ(Eigen::Vector3d(m.params()), k);
+}
+
+TEST(VignetteModel, FixedDividesByThePolynomialAndIsNotEstimated) {
+  VignetteModel m(VignetteModel::Mode::Fixed, 0.05, Eigen::Vector3d(-0.2, 0.0, 0.0));
+  m.setSensors(sensors());
+  EXPECT_TRUE(m.isCalibrated());
+  EXPECT_FALSE(m.estimatesOnline());
+  EXPECT_EQ(m.numParams(), 0);
+  cv::Mat img(30, 40, CV_32F, cv::Scalar(60.0));
+  m.correct(img, frame());
+  EXPECT_FLOAT_EQ(img.at<float>(0, 0), static_cast<float>(60.0 / 0.8));
+  EXPECT_FALSE(m.refineFromResiduals(vignetteRows(Eigen::Vector3d(-0.3, 0, 0), Eigen::Vector3d(-0.2, 0, 0),
+                                                  1.0, 1),
+                                     nullptr));
 }
 
 TEST(VignetteModel, ErrorsNameTheSlotAndFile) {

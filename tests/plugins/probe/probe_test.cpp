@@ -136,7 +136,7 @@ TEST(Probes, ExposureSignatureNamesExposure) {
 }
 
 TEST(Probes, VignettingSignatureNamesVignettingWithANegativeK1) {
-  expectWinner(Effect::Vignetting, "probe.vignetting", "photometric.vignette.params.mode=fixed");
+  expectWinner(Effect::Vignetting, "probe.vignetting", "photometric.vignette.params.mode=estimate");
   const auto r = evaluateAll(syntheticLog(Effect::Vignetting, 7), kGlobalNoAffine).at("probe.vignetting");
   // The suggested polynomial is the fit with the host radius: the corner's fall-off and the curve.
   EXPECT_EQ(r.details.at("fit_params").get<int>(), 3);

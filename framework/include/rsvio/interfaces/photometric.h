@@ -9,13 +9,23 @@
 //   scaled so that 0..255 spans the raw range whatever the bit depth.
 // - hasAffineBrightness(): this model adds (a, b) per frame to the optimisation; the priors say how
 //   strongly a and b are pulled to 0 (DSO's affine priors; 0 = free).
-// - Models with parameters estimated online (e.g. a vignetting polynomial when no calibration file is
-//   given) expose them through numParams/params/setParams and predict the target-side value with its
-//   derivatives in predict(); the default is the identity.
+// - Models with parameters expose them through numParams/params/setParams and may predict the
+//   target-side value with its derivatives in predict() (the default is the identity; the back end does
+//   not call predict()).
+// - Online estimation by alternation (estimatesOnline(), e.g. photometric.vignette without a
+//   calibration): correct() applies the current parameters, and after each keyframe the back end hands
+//   refineFromResiduals() the observations that left the window (io/diagnostics_log.h rows, outliers
+//   with weight 0) whose host and target images were both corrected with them, once there are at least
+//   minRowsForRefine(). It returns true when the parameters changed; the frames after that keyframe are
+//   corrected with the new ones, and the rows before are not handed over again.
 #pragma once
 #include <Eigen/Core>
 
+#include <string>
+#include <vector>
+
 #include "rsvio/core/types.h"
+#include "rsvio/io/diagnostics_log.h"
 #include "rsvio/plugin/plugin.h"
 
 namespace rsvio {
@@ -36,6 +46,10 @@ class PhotometricModel : public PluginBase {
   virtual void setParams(const Eigen::VectorXd& /*p*/) {}
   // Predicted working-domain value at raw pixel uv of a scene value `value`; d_value = d out / d value,
   // d_params (size numParams()) = d out / d params when non-null.
+  virtual bool estimatesOnline() const { return false; }
+  virtual size_t minRowsForRefine() const { return 0; }
+  // `note`: one line saying what changed (the run's report keeps it).
+  virtual bool refineFromResiduals(const std::vector<ObservationRow>& /*rows*/, std::string* /*note*/) { return false; }
   virtual double predict(double value, const Vec2& /*uv*/, double* d_value, Eigen::VectorXd* d_params) const {
     if (d_value) *d_value = 1.0;
     if (d_params) d_params->resize(0);

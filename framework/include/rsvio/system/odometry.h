@@ -81,6 +81,9 @@ class Odometry {
   // Rolling shutter (null for a global shutter): the line delay the run ended with, whether it was
   // estimated online and where the estimate started (report.json "shutter").
   nlohmann::json shutterReport() const;
+  // Photometric models estimated online (photometric.vignette without a calibration): each slot's final
+  // parameters and every refinement (frame, parameters, what changed); null without one.
+  nlohmann::json photometricReport() const;
   std::vector<std::string> warnings() const;
 
   struct Impl;
