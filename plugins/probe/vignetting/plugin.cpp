@@ -5,9 +5,10 @@
 // residual of a point of host intensity I seen at host radius rho_h and target radius rho_t is
 //   r = I (V(rho_t) / V(rho_h) - 1) ~ k1 I (rho_t^2 - rho_h^2).
 // The statistic: after removing the pair's gain and offset ([1, I], what photometric.affine absorbs)
-// the regressor x = I rho_t^2 carries k1; the cluster-robust score test of k1 = 0, |z|
-// (plugins/probe/common/probe_common.h). Its one-step k1 is biased towards 0 (host and target radii of
-// a point are correlated), so it is reported but not suggested.
+// the regressor x = I (rho_t^2 - rho_h^2) carries k1; the cluster-robust score test of k1 = 0, -z
+// (plugins/probe/common/probe_common.h), with the inliers only. Its one-step k1 is biased towards 0
+// (the outliers the test leaves out hold the largest vignetting residuals), so it is reported but not
+// suggested. Named when both -z / threshold and the fitted corner fall-off / min_falloff exceed 1.
 // The estimate suggested: (k1, k2, k3) fitted to the residuals with the full ratio V(rho_t) / V(rho_h)
 // (the log's host_radius) and the dropped outliers (rsvio/photometric/vignette_fit.h).
 #include <Eigen/Dense>
@@ -63,7 +64,7 @@ class VignettingProbe : public DiagnosticProbe {
       refine = true;
     }
     const auto x_of = [](const ObservationRow& o) {
-      return static_cast<double>(o.intensity) * o.radius * o.radius;
+      return static_cast<double>(o.intensity) * (o.radius * o.radius - o.host_radius * o.host_radius);
     };
     const auto e_of = [](const ObservationRow& o) { return static_cast<double>(o.radius); };
     const probe::PooledResult s = probe::pooledScore(log, x_of, e_of, 2);

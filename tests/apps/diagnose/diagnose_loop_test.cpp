@@ -160,10 +160,11 @@ TEST(DiagnoseLoop, ExposureNamedAndAffineMakesTheErrorFall) {
   }
 }
 
-// Vignetting (corner at half the centre), gs_vo with affine brightness, seed 2: named; the fitted
-// polynomial (photometric.vignette mode fixed) corrects most of the fall-off, the new run is named again
-// for what it left and the refined polynomial replaces it, up to three rounds; asked: the ATE 2x lower
-// and the evidence gone at the end (plugins/probe/vignetting/README.md).
+// Vignetting (corner at half the centre), gs_vo with affine brightness, seed 1: named (statistic 4.6);
+// the line starts photometric.vignette in mode estimate from the probe's fit and the run refines it
+// online (three refinements): measured ATE 44.6 mm -> 4.7 mm, evidence 4.61 -> 0.63; asked: 2x and the
+// evidence gone. A run with a fixed polynomial would be named again for what it left (up to three
+// rounds here; plugins/probe/vignetting/README.md).
 TEST(DiagnoseLoop, VignettingNamedAndTheSuggestedPolynomialMakesTheErrorFall) {
   const fs::path dir = workDir("vignetting");
   simulate(dir / "data", 1, kVignette);
