@@ -13,9 +13,9 @@ struct Pair {
   std::vector<double> w, I, rt, rh, r;
 };
 
-// The weighted projection of v off [1, I] (as probe_common's projectOff with both columns; only the
-// mean when the intensities are all alike).
-void projectOffAffine(const std::vector<double>& w, const std::vector<double>& I, std::vector<double>& v) {
+}  // namespace
+
+void projectOffGainOffset(const std::vector<double>& w, const std::vector<double>& I, std::vector<double>& v) {
   double s0 = 0, s1 = 0, s2 = 0, t0 = 0, t1 = 0;
   for (size_t i = 0; i < v.size(); ++i) {
     s0 += w[i];
@@ -26,7 +26,7 @@ void projectOffAffine(const std::vector<double>& w, const std::vector<double>& I
   }
   if (!(s0 > 0)) return;
   const double det = s0 * s2 - s1 * s1;
-  if (!(det > 1e-9 * s0 * s2)) {
+  if (!(det > 1e-9 * s0 * s2)) {  // intensities all alike: only the mean can be removed
     const double m = t0 / s0;
     for (auto& x : v) x -= m;
     return;
@@ -35,8 +35,6 @@ void projectOffAffine(const std::vector<double>& w, const std::vector<double>& I
   const double c1 = (s0 * t1 - s1 * t0) / det;
   for (size_t i = 0; i < v.size(); ++i) v[i] -= c0 + c1 * I[i];
 }
-
-}  // namespace
 
 double vignetteValue(const Eigen::Vector3d& k, double rho) {
   const double q = rho * rho;
@@ -110,8 +108,8 @@ VignetteFit fitVignette(const std::vector<ObservationRow>& rows, int n_params, d
           J[static_cast<size_t>(j)][i] = p.I[i] * (qt * vh - vt * qh) / (vh * vh);  // d (I V_t / V_h) / d k_j
         }
       }
-      projectOffAffine(p.w, p.I, e);
-      for (auto& c : J) projectOffAffine(p.w, p.I, c);
+      projectOffGainOffset(p.w, p.I, e);
+      for (auto& c : J) projectOffGainOffset(p.w, p.I, c);
       for (size_t i = 0; i < m; ++i) {
         const double a = std::abs(e[i]);
         const bool clipped = huber > 0 && a > huber;

@@ -25,6 +25,7 @@
 
 #include "rsvio/interfaces/diagnostic_probe.h"
 #include "rsvio/io/diagnostics_log.h"
+#include "rsvio/photometric/vignette_fit.h"
 
 namespace rsvio::probe {
 
@@ -96,30 +97,18 @@ struct Nuisance {
 
 inline void projectOff(const std::vector<double>& w, const std::vector<double>& I, int k, std::vector<double>& v) {
   if (k == 0 || v.empty()) return;
-  const size_t n = v.size();
-  double s0 = 0, s1 = 0, s2 = 0, t0 = 0, t1 = 0;
-  for (size_t i = 0; i < n; ++i) {
+  if (k == 2) {
+    projectOffGainOffset(w, I, v);  // rsvio/photometric/vignette_fit.h
+    return;
+  }
+  double s0 = 0, t0 = 0;
+  for (size_t i = 0; i < v.size(); ++i) {
     s0 += w[i];
-    s1 += w[i] * I[i];
-    s2 += w[i] * I[i] * I[i];
     t0 += w[i] * v[i];
-    t1 += w[i] * I[i] * v[i];
   }
   if (!(s0 > 0)) return;
-  if (k == 1) {
-    const double m = t0 / s0;
-    for (auto& x : v) x -= m;
-    return;
-  }
-  const double det = s0 * s2 - s1 * s1;
-  if (!(det > 1e-9 * s0 * s2)) {  // intensities all alike: only the mean can be removed
-    const double m = t0 / s0;
-    for (auto& x : v) x -= m;
-    return;
-  }
-  const double c0 = (s2 * t0 - s1 * t1) / det;
-  const double c1 = (s0 * t1 - s1 * t0) / det;
-  for (size_t i = 0; i < n; ++i) v[i] -= c0 + c1 * I[i];
+  const double m = t0 / s0;
+  for (auto& x : v) x -= m;
 }
 
 // Binned curve of the evidence: mean projected residual (and mean fitted part) per bin of the

@@ -29,6 +29,10 @@ struct VignetteFit {
   double cost = 0.0;       // at the fit
 };
 
+// The weighted projection of v off the columns [1, I] (a pair's gain and offset on its host
+// intensities I); only the mean when the intensities are all alike. probe.* share it (probe_common.h).
+void projectOffGainOffset(const std::vector<double>& w, const std::vector<double>& I, std::vector<double>& v);
+
 // V(rho) of the polynomial k.
 double vignetteValue(const Eigen::Vector3d& k, double rho);
 
