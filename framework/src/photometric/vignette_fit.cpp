@@ -36,6 +36,19 @@ void projectOffGainOffset(const std::vector<double>& w, const std::vector<double
   for (size_t i = 0; i < v.size(); ++i) v[i] -= c0 + c1 * I[i];
 }
 
+double vignetteResidual(const Eigen::Vector3d& k, double intensity, double rho_t, double rho_h, Eigen::Vector3d* J) {
+  const double vt = vignetteValue(k, rho_t), vh = vignetteValue(k, rho_h);
+  if (J) {
+    double qt = 1.0, qh = 1.0;
+    for (int j = 0; j < 3; ++j) {
+      qt *= rho_t * rho_t;
+      qh *= rho_h * rho_h;
+      (*J)[j] = intensity * (qt * vh - vt * qh) / (vh * vh);
+    }
+  }
+  return intensity * (vt / vh - 1.0);
+}
+
 double vignetteValue(const Eigen::Vector3d& k, double rho) {
   const double q = rho * rho;
   return 1.0 + q * (k[0] + q * (k[1] + q * k[2]));
@@ -98,15 +111,10 @@ VignetteFit fitVignette(const std::vector<ObservationRow>& rows, int n_params, d
       const size_t m = p.w.size();
       e.resize(m);
       for (auto& c : J) c.resize(m);
+      Eigen::Vector3d Ji;
       for (size_t i = 0; i < m; ++i) {
-        const double vt = vignetteValue(k, p.rt[i]), vh = vignetteValue(k, p.rh[i]);
-        e[i] = p.r[i] - p.I[i] * (vt / vh - 1.0);
-        double qt = 1.0, qh = 1.0;
-        for (int j = 0; j < n; ++j) {
-          qt *= p.rt[i] * p.rt[i];
-          qh *= p.rh[i] * p.rh[i];
-          J[static_cast<size_t>(j)][i] = p.I[i] * (qt * vh - vt * qh) / (vh * vh);  // d (I V_t / V_h) / d k_j
-        }
+        e[i] = p.r[i] - vignetteResidual(k, p.I[i], p.rt[i], p.rh[i], &Ji);
+        for (int j = 0; j < n; ++j) J[static_cast<size_t>(j)][i] = Ji[j];
       }
       projectOffGainOffset(p.w, p.I, e);
       for (auto& c : J) projectOffGainOffset(p.w, p.I, c);

@@ -75,6 +75,20 @@ std::vector<ObservationRow> vignetteRows(const Eigen::Vector3d& truth, const Eig
   return rows;
 }
 
+// The fit's Jacobian (rsvio/photometric/vignette_fit.h) against central differences, at a few
+// observations spread over the radii.
+TEST(VignetteFit, ResidualJacobianMatchesNumericDifferences) {
+  const Eigen::Vector3d k(-0.3, -0.15, -0.05);
+  for (const auto& [rt, rh] : std::vector<std::pair<double, double>>{{0.1, 0.9}, {0.5, 0.5}, {1.0, 0.3}, {0.7, 0.0}}) {
+    Eigen::Vector3d J;
+    vignetteResidual(k, 120.0, rt, rh, &J);
+    const Eigen::MatrixXd num = test::numericJacobian(
+        [&](const Eigen::VectorXd& kk) { return vignetteResidual(Eigen::Vector3d(kk), 120.0, rt, rh, nullptr); },
+        Eigen::VectorXd(k), test::vectorPlus, 3);
+    EXPECT_JACOBIAN_NEAR(J.transpose(), num, 1e-6) << "rho_t " << rt << " rho_h " << rh;
+  }
+}
+
 TEST(VignetteModel, EstimatedOnlineDividesByThePolynomialAndRefinesItFromResiduals) {
   const Eigen::Vector3d initial(-0.1, 0.0, 0.0), truth(-0.3, -0.15, -0.05);
   VignetteModel m(VignetteModel::Mode::Auto, 0.05, initial, "photometric.vignette", /*min_rows=*/1000);

@@ -33,6 +33,10 @@ struct VignetteFit {
 // intensities I); only the mean when the intensities are all alike. probe.* share it (probe_common.h).
 void projectOffGainOffset(const std::vector<double>& w, const std::vector<double>& I, std::vector<double>& v);
 
+// The model residual of one observation, m = I (V(rho_t) / V(rho_h) - 1), and (when J) its derivative
+// with respect to (k1, k2, k3): dm/dk_j = I (rho_t^2j V(rho_h) - V(rho_t) rho_h^2j) / V(rho_h)^2.
+double vignetteResidual(const Eigen::Vector3d& k, double intensity, double rho_t, double rho_h, Eigen::Vector3d* J);
+
 // V(rho) of the polynomial k.
 double vignetteValue(const Eigen::Vector3d& k, double rho);
 
