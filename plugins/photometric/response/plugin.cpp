@@ -25,7 +25,9 @@ void registerAll(PluginRegistrar& r) {
         const ResponseModel::Mode mode = m == "calibrated" ? ResponseModel::Mode::Calibrated
                                          : m == "estimate" ? ResponseModel::Mode::Estimate
                                                            : ResponseModel::Mode::Auto;
-        const std::string where = p.where().empty() ? "photometric.response" : p.where();
+        // The slot's path (Params::where() is "<slot>.params"; the model's messages add ".params.<key>").
+        std::string where = p.where().empty() ? "photometric.response" : p.where();
+        if (where.size() > 7 && where.compare(where.size() - 7, 7, ".params") == 0) where.resize(where.size() - 7);
         return std::make_unique<ResponseModel>(mode, p.getDouble("initial_gamma"), where);
       });
 }

@@ -32,7 +32,9 @@ void registerAll(PluginRegistrar& r) {
                                          : m == "fixed"    ? VignetteModel::Mode::Fixed
                                                            : VignetteModel::Mode::Auto;
         const std::vector<double> v = p.getArray("initial");
-        const std::string where = p.where().empty() ? "photometric.vignette" : p.where();
+        // The slot's path (Params::where() is "<slot>.params"; the model's messages add ".params.<key>").
+        std::string where = p.where().empty() ? "photometric.vignette" : p.where();
+        if (where.size() > 7 && where.compare(where.size() - 7, 7, ".params") == 0) where.resize(where.size() - 7);
         return std::make_unique<VignetteModel>(mode, p.getDouble("min_value"), Eigen::Vector3d(v[0], v[1], v[2]),
                                                where, static_cast<size_t>(p.getInt("min_rows")),
                                                p.getDouble("min_gain"));

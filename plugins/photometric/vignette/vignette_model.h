@@ -58,6 +58,12 @@ class VignetteModel : public PhotometricModel {
       // Estimated: the same division with the current polynomial, refined online.
       if (cam.width <= 0 || cam.height <= 0)
         throw ConfigError(where_ + ".params.mode: a polynomial vignette needs the image size");
+      if (!plausibleVignette(v_)) {
+        std::ostringstream os;
+        os << where_ << ".params.initial: V(r) = 1 + " << v_[0] << " r^2 + " << v_[1] << " r^4 + " << v_[2]
+           << " r^6 leaves (0.05, 1.5) between the centre and the corner";
+        throw ConfigError(os.str());
+      }
       size_ = cv::Size(cam.width, cam.height);
       buildInverse();
       calibrated_ = mode_ == Mode::Fixed;

@@ -129,6 +129,18 @@ TEST(VignetteModel, EstimatedOnlineDividesByThePolynomialAndRefinesItFromResidua
   EXPECT_EQ(Eigen::Vector3d(m.params()), k);
 }
 
+TEST(VignetteModel, AnImplausiblePolynomialIsAConfigErrorNamingTheKey) {
+  for (const auto mode : {VignetteModel::Mode::Fixed, VignetteModel::Mode::Estimate}) {
+    VignetteModel m(mode, 0.05, Eigen::Vector3d(-1.2, 0.0, 0.0), "photometric.v");
+    try {
+      m.setSensors(sensors());
+      FAIL() << "no error";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("photometric.v.params.initial"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(VignetteModel, FixedDividesByThePolynomialAndIsNotEstimated) {
   VignetteModel m(VignetteModel::Mode::Fixed, 0.05, Eigen::Vector3d(-0.2, 0.0, 0.0));
   m.setSensors(sensors());
