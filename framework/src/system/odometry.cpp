@@ -123,9 +123,10 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
   }
-  // A photometric model's own parameters (PhotometricModel::numParams, e.g. photometric.response's
-  // gamma in mode "estimate") are not optimised by this back end: say so instead of running silently
-  // as if the model were there.
+  // Models estimated online by alternation (photometric.vignette without a calibration) get the rows
+  // of what leaves the window (refinePhotometric). Any other model's own parameters
+  // (PhotometricModel::numParams, e.g. photometric.response's gamma in mode "estimate") are not
+  // optimised by this back end: say so instead of running silently as if the model were there.
   for (size_t i = 0; i < photometric_ptrs.size(); ++i)
     if (photometric_ptrs[i]->estimatesOnline()) photometric_online.push_back(i);
   record->keepRowsForPhotometric(!photometric_online.empty());

@@ -44,12 +44,12 @@ class PhotometricModel : public PluginBase {
   virtual int numParams() const { return 0; }
   virtual Eigen::VectorXd params() const { return Eigen::VectorXd(); }
   virtual void setParams(const Eigen::VectorXd& /*p*/) {}
-  // Predicted working-domain value at raw pixel uv of a scene value `value`; d_value = d out / d value,
-  // d_params (size numParams()) = d out / d params when non-null.
+  // Online estimation by alternation (above). `note`: one line saying what changed (report.json keeps it).
   virtual bool estimatesOnline() const { return false; }
   virtual size_t minRowsForRefine() const { return 0; }
-  // `note`: one line saying what changed (the run's report keeps it).
   virtual bool refineFromResiduals(const std::vector<ObservationRow>& /*rows*/, std::string* /*note*/) { return false; }
+  // Predicted working-domain value at raw pixel uv of a scene value `value`; d_value = d out / d value,
+  // d_params (size numParams()) = d out / d params when non-null.
   virtual double predict(double value, const Vec2& /*uv*/, double* d_value, Eigen::VectorXd* d_params) const {
     if (d_value) *d_value = 1.0;
     if (d_params) d_params->resize(0);
