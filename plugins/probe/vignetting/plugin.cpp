@@ -95,6 +95,7 @@ class VignettingProbe : public DiagnosticProbe {
     if (refine)
       ex << " (the run's fixed polynomial, corner at " << 100.0 * vignetteValue(k_run, 1.0)
          << " %, left a corner at " << 100.0 * vignetteValue(fit.k, 1.0) << " %)";
+    ex << "; the residuals understate it, the line starts the online estimate there";
     r.explanation = ex.str();
     r.details = probe::toJson(s);
     r.details["k1_one_step"] = s.beta;
