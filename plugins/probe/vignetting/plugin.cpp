@@ -13,7 +13,6 @@
 // (the log's host_radius) and the dropped outliers (rsvio/photometric/vignette_fit.h).
 #include <Eigen/Dense>
 #include <cmath>
-#include <map>
 #include <memory>
 #include <sstream>
 
@@ -72,14 +71,14 @@ class VignettingProbe : public DiagnosticProbe {
     ProbeResult r;
     r.effect = effect();
     r.plugin = "photometric.vignette";
-    // A vignette darkens the border: only a negative k1 is vignetting (a positive one is something else).
     r.threshold = 1.0;
     VignetteFit fit = fitVignettePlausible(log.observations);
     // A brightening towards the border is not vignetting (after a fixed polynomial it is an overshoot).
     if (!refine && fit.k[0] > 0.0) fit.k.setZero();
     const Eigen::Vector3d k = refine ? vignetteProduct(k_run, fit.k) : fit.k;
-    // Both conditions, each against its own threshold: the score test, -z / threshold, and the fitted
-    // fall-off at the corner (what the run's images still lack), 1 - V(1) / min_falloff; named above 1.
+    // Both conditions, each against its own threshold: the score test, -z / threshold (a vignette darkens
+    // the border: only a negative z counts), and the fitted fall-off at the corner (what the run's images
+    // still lack), (1 - V(1)) / min_falloff; named above 1.
     const double z_part = std::max(0.0, -s.z) / threshold_;
     const double falloff = 1.0 - vignetteValue(fit.k, 1.0);
     r.statistic = std::min(z_part, min_falloff_ > 0 ? std::max(0.0, falloff) / min_falloff_ : INFINITY);
