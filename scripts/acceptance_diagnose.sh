@@ -45,8 +45,10 @@ simcfg() {
 EXPOSURE_EFFECT='effects.exposure={"plugin":"effect.exposure","params":{"amplitude_stops":1.0,"period_s":8.0,"jitter_stops":0.05}}'
 sim_sets() { case "$1" in rs_exposure) echo "--set $EXPOSURE_EFFECT" ;; esac; }
 simname() { case "$1" in rs_exposure) echo rs_exposure ;; *) basename "$(simcfg "$1")" .json ;; esac; }
-# Rounds of diagnosis per case: 3 for two hidden effects (both named, then none), else 1 unless
-# ROUNDS says otherwise (ROUNDS=2 checks that the second diagnosis gives none).
+# Rounds of diagnosis per case: 3 for two hidden effects (both named, then none) and for vignetting (a
+# run with a fixed polynomial is named again for what it left; with the online estimate one round
+# suffices and the second gives none), else 1 unless ROUNDS says otherwise (ROUNDS=2 checks that the
+# second diagnosis gives none).
 rounds() { case "$1" in rs_exposure|vignetting) echo 3 ;; *) echo "${ROUNDS:-1}" ;; esac; }
 model() { case "$1" in time_offset|clean_vio) echo "$CFG/default.json" ;; *) echo "$CFG/gs_vo.json" ;; esac; }
 base_sets() { case "$1" in exposure|rs_exposure|clean_noaffine) echo "--set photometric.affine=null" ;; esac; }

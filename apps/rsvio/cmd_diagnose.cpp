@@ -308,7 +308,7 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
       if (!(std::isfinite(o.residual) && o.weight > 0)) continue;
       ++usable;
       kfs[o.frame] = 1;
-      pairs[(static_cast<int64_t>(o.frame) << 32) | static_cast<uint32_t>(o.host)] = 1;
+      pairs[pairKey(o)] = 1;
       t0 = std::min(t0, o.t_ns);
       t1 = std::max(t1, o.t_ns);
     }

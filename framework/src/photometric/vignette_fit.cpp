@@ -83,7 +83,7 @@ VignetteFit fitVignette(const std::vector<ObservationRow>& rows, int n_params, d
     if (!(std::isfinite(o.residual) && std::isfinite(o.intensity) && std::isfinite(o.radius) &&
           std::isfinite(o.host_radius) && std::isfinite(o.weight) && o.weight >= 0.f))
       continue;
-    Pair& p = by_pair[(static_cast<int64_t>(o.frame) << 32) | static_cast<uint32_t>(o.host)];
+    Pair& p = by_pair[pairKey(o)];
     p.w.push_back(o.weight > 0.f ? o.weight : 1.0);
     p.I.push_back(o.intensity);
     p.rt.push_back(rho_scale * o.radius);

@@ -128,21 +128,14 @@ class VignetteModel : public PhotometricModel {
   }
 
   double radius(const Vec2& uv) const { return (uv - centre_).norm() * inv_r_max_; }
-  double vignette(const Vec2& uv) const {
-    const double r2 = (uv - centre_).squaredNorm() * inv_r_max_ * inv_r_max_;
-    return 1.0 + r2 * (v_[0] + r2 * (v_[1] + r2 * v_[2]));
-  }
+  double vignette(const Vec2& uv) const { return vignetteValue(v_, radius(uv)); }
 
-  double predict(double value, const Vec2& uv, double* d_value, Eigen::VectorXd* d_params) const override {
-    if (calibrated_ || estimating_) return PhotometricModel::predict(value, uv, d_value, d_params);
-    const double r2 = (uv - centre_).squaredNorm() * inv_r_max_ * inv_r_max_;
-    const double V = 1.0 + r2 * (v_[0] + r2 * (v_[1] + r2 * v_[2]));
-    if (d_value) *d_value = V;
-    if (d_params) {
-      d_params->resize(3);
-      *d_params << value * r2, value * r2 * r2, value * r2 * r2 * r2;
-    }
-    return V * value;
+  // The images carry the correction (calibrated, fixed or estimated): the identity, with zero
+  // derivatives for the polynomial's parameters when it is estimated.
+  double predict(double value, const Vec2& /*uv*/, double* d_value, Eigen::VectorXd* d_params) const override {
+    if (d_value) *d_value = 1.0;
+    if (d_params) d_params->setZero(numParams());
+    return value;
   }
 
  private:

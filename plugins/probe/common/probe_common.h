@@ -49,9 +49,6 @@ inline bool usable(const ObservationRow& o) {
          std::isfinite(o.vel_u) && std::isfinite(o.vel_v);
 }
 
-inline int64_t pairKey(const ObservationRow& o) {
-  return (static_cast<int64_t>(o.frame) << 32) | static_cast<uint32_t>(o.host);
-}
 
 // Indices of usable observations grouped by (frame, host), clusters in frame order.
 inline std::vector<std::vector<size_t>> clusters(const DiagnosticsLog& log, size_t min_size) {

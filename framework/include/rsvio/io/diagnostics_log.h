@@ -46,6 +46,11 @@ struct ObservationRow {
   float exposure_ratio = 1;
 };
 
+// The (target frame, host keyframe) pair of an observation as one key (probes and fits group by it).
+inline int64_t pairKey(const ObservationRow& o) {
+  return (static_cast<int64_t>(o.frame) << 32) | static_cast<uint32_t>(o.host);
+}
+
 struct ImuRow {
   int64_t t_i_ns = 0;
   int64_t t_j_ns = 0;
