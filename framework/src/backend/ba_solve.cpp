@@ -438,7 +438,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
     ba::evaluatePhotometric(m, m.trial, config_, camera_, timing_);
     ++s.iterations;
     const double e_new = ba::photometricEnergy(m, m.trial) + ba::cameraTermsEnergy(m, config_, terms_);
-    if (e_new < e) {
+    if (e_new < e || config_.accept_all_steps) {
       const bool small = config_.min_step_rad > 0.0 && ba::stepIsSmall(window, idepth_backup, dx_c, dx_p, config_);
       ba::accumulatePhotometric(m, m.trial, config_, false);
       ba::addCameraTerms(m, m.trial, config_, terms_);
@@ -452,7 +452,7 @@ BundleAdjustmentStats BundleAdjuster::optimize(KeyframeList& window, const Margi
         s.small_step = true;
         break;
       }
-      if (rel < config_.step_threshold) break;
+      if (rel < config_.step_threshold && !config_.accept_all_steps) break;
     } else {
       for (auto& kf : window) kf->state = kf->backup;
       if (m.globals && config_.layout.globalDim() > 0) m.globals->state = m.globals->backup;

@@ -25,6 +25,9 @@ ParamTable backendParamTable() {
       paramInt("max_rejected_steps", d.max_rejected_steps, 0, 100, "",
                "stop iterating after this many rejected Levenberg-Marquardt steps in a row (0: no such stop; "
                "docs/performance.md, Rejected steps)"),
+      paramBool("accept_all_steps", d.accept_all_steps,
+                "take every Levenberg-Marquardt step, also one that raises the energy (DSO's setting_forceAceptStep); "
+                "the iterations then end on max_iterations or min_step_rad only"),
       paramDouble("min_step_rad", d.min_step_rad, 0.0, 1.0, "rad",
                   "stop iterating after an accepted step whose RMS keyframe rotation and RMS translation x mean "
                   "inverse depth are both below this (DSO's test, 6e-5 there) and whose inverse-depth steps are "
@@ -104,6 +107,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.lambda_initial = p.getDouble("lambda_initial");
   o.step_threshold = p.getDouble("step_threshold");
   o.max_rejected_steps = static_cast<int>(p.getInt("max_rejected_steps"));
+  o.accept_all_steps = p.getBool("accept_all_steps");
   o.min_step_rad = p.getDouble("min_step_rad");
   o.min_step_idepth = p.getDouble("min_step_idepth");
   o.marg_weight_factor = p.getDouble("marg_weight_factor");

@@ -78,6 +78,7 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   bc.lambda_initial = bo.lambda_initial;
   bc.step_threshold = bo.step_threshold;
   bc.max_rejected_steps = bo.max_rejected_steps;
+  bc.accept_all_steps = bo.accept_all_steps;
   bc.min_step_rad = bo.min_step_rad;
   bc.min_step_idepth = bo.min_step_idepth;
   bc.twist_regularization = bo.twist_regularization;

@@ -132,6 +132,25 @@ TEST(BundleAdjustment, StopsAfterTheConfiguredRejectedSteps) {
   EXPECT_LT(two.energy_final, 1.001 * all.energy_final);  // it stopped converged, not early
 }
 
+// BundleAdjustmentConfig::accept_all_steps (DSO's setting_forceAceptStep): every step is taken, none
+// rejected, and neither a small energy decrease (step_threshold, here the default 1e-4) nor a rise ends
+// the iterations: only max_iterations (or the small-step stop, off here) does. The converged window
+// stays converged: its energy within 1 % of the run that rejects the steps that raise it.
+TEST(BundleAdjustment, AcceptAllStepsTakesEveryStepToTheIterationLimit) {
+  const BundleAdjustmentStats rejecting = optimizeWithoutEnergyStop([](BundleAdjustmentConfig&) {});
+  const BundleAdjustmentStats all = optimizeWithoutEnergyStop([](BundleAdjustmentConfig& c) {
+    c.accept_all_steps = true;
+    c.step_threshold = 1e-4;
+  });
+  EXPECT_FALSE(all.solver_failed || rejecting.solver_failed);
+  ASSERT_GE(rejecting.rejected, 3);  // without the option the converged window rejects steps
+  EXPECT_EQ(all.iterations, 16);
+  EXPECT_EQ(all.accepted, 16);
+  EXPECT_EQ(all.rejected, 0);
+  EXPECT_LT(all.energy_final, 1.01 * rejecting.energy_final);
+  EXPECT_LT(all.energy_final, 0.5 * all.energy_initial);
+}
+
 // BundleAdjustmentConfig::min_step_rad / min_step_idepth (the small-step stop): with no stop on the
 // energy decrease, the window iterates to the limit; with the stop it ends at the first accepted step
 // whose pose and inverse-depth increments are below the thresholds, after the large first steps (the

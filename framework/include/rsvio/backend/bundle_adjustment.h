@@ -74,6 +74,9 @@ struct BundleAdjustmentConfig {
   // end them). A rejected step's relative damping (1e-4 x 4^k) barely changes the next step, so
   // further tries mostly repeat it (docs/performance.md, "Rejected steps").
   int max_rejected_steps = 0;
+  // DSO's setting_forceAceptStep: every step is taken, whatever the energy does; the iterations end on
+  // max_iterations or the small-step stop only (not on step_threshold or rejections).
+  bool accept_all_steps = false;
   // The small-step stop: after an accepted step, stop when the RMS over the window's keyframes of the
   // pose step's rotation (rad) and of its translation times the points' mean inverse depth (rad: the
   // translation seen at the mean depth) are both below min_step_rad (DSO's test in doStepFromBackup;
