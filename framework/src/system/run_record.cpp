@@ -193,13 +193,19 @@ io::Trajectory RunRecord::frameTrajectory(const KeyframeList& window, std::vecto
       }
     poses.emplace_back(stamped(f.t_ns, T), map ? (in_window ? currentTransform() : transformOf(ref)) : RxSO3d());
   }
-  std::stable_sort(poses.begin(), poses.end(), [](const auto& a, const auto& b) { return a.first.t_ns < b.first.t_ns; });
+  // In time order, ties in record order. Indices are sorted, not the pairs: std::stable_sort's temporary
+  // buffer (libstdc++ 12) ignores over-alignment, and RxSO3d needs 32 bytes with AVX (-march=native).
+  std::vector<size_t> order(poses.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return poses[a].first.t_ns != poses[b].first.t_ns ? poses[a].first.t_ns < poses[b].first.t_ns : a < b;
+  });
   io::Trajectory t;
   t.frame = io::PoseFrame::kCamera;
   if (T_wm_wf) T_wm_wf->clear();
-  for (const auto& [p, T] : poses) {
-    t.poses.push_back(p);
-    if (map) T_wm_wf->push_back(T);
+  for (size_t i : order) {
+    t.poses.push_back(poses[i].first);
+    if (map) T_wm_wf->push_back(poses[i].second);
   }
   return t;
 }
