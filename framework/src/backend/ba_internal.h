@@ -15,7 +15,8 @@ constexpr int kPointChunks = 16;
 
 using Mat66 = Eigen::Matrix<double, 6, 6>;
 using Vec6d = Eigen::Matrix<double, 6, 1>;
-// d uv / d (host pose 6, host twist 6, target pose 6, target twist 6, idepth 1).
+// d uv / d (host pose 6, host twist 6, target pose 6, target twist 6, idepth 1). A global-shutter
+// linearisation fills the target pose and the inverse depth only (accumulateChunkGlobal).
 using GeoJac = Eigen::Matrix<double, 2, 25>;
 constexpr int kColHostPose = 0, kColHostTwist = 6, kColTargetPose = 12, kColTargetTwist = 18, kColIdepth = 24;
 
@@ -58,6 +59,9 @@ struct Linearization {
   std::vector<int> blk_begin, blk_count;  // per point: involved blocks in the arena
   std::vector<int> blk_ids;             // window indices (host first)
   std::vector<double> hpc;              // kfDim values per arena entry: d^2 E / d rho d x_block
+  // Global shutter: per pair (h * nk + t), Adj(T_t T_h^-1) of the evaluated states, with which
+  // d uv / d host pose = -d uv / d target pose * Adj (left perturbations of T_c_w, lie.h).
+  std::vector<Eigen::Matrix<double, 6, 6>> pair_adj;
   Eigen::MatrixXd Hcc;                  // cameras: photometric + priors + terms, undamped, unmasked
   Eigen::VectorXd bc;
   double energy_photo = 0.0;            // all observations (kOob/kOutlier at the outlier energy)
@@ -74,6 +78,12 @@ struct ChunkSums {
   // entry and its gradient.
   Eigen::VectorXd Hl;
   double Hll = 0.0, bl = 0.0;
+  // Global shutter (accumulateChunkGlobal): per host-target pair, the normal equations over
+  // (target pose 6, host affine 2, target affine 2), mapped to the host pose with the pair's adjoint
+  // once per chunk; pair_used marks the pairs this chunk touched.
+  std::vector<Eigen::Matrix<double, 10, 10>> pair_H;
+  std::vector<Eigen::Matrix<double, 10, 1>> pair_b;
+  std::vector<uint8_t> pair_used;
   double energy = 0.0, energy_in = 0.0;
   int num_in = 0, num_oob = 0, num_outlier = 0;
 };

@@ -97,8 +97,9 @@ Eigen::Matrix<double, 3, 6> dLeftAction(const Vec3& p) {
 // Global shutter (no twists in the layout): projectRollingShutter() of host points at row time 0 with
 // the same arithmetic in the same order, without the factors that are identities there (exp(0), its
 // rotation matrix, the implicit-row correction with a = 0) and without filling its general outputs, so
-// uv and the Jacobians are bit-identical to the general call. Fills valid, uv, d_uv_d_X, d_uv_d_T0,
-// d_uv_d_Th0, d_uv_d_idepth of pw.proj; the twist and line-delay Jacobians are not used by the
+// uv and the Jacobians are bit-identical to the general call. Fills valid, uv, d_uv_d_X, d_uv_d_T0 and
+// d_uv_d_idepth of pw.proj; the host pose's Jacobian (accumulateChunkGlobal forms the host's blocks
+// from the target's with the pair's adjoint), the twists' and the line delay's are not used by the
 // global-shutter accumulation and are left as they are.
 void projectPairGlobal(const CameraModel& camera, const RsFrame& host, const RsFrame& target, PairWork& pw) {
   const Eigen::Index n = pw.bearing.cols();
@@ -133,9 +134,7 @@ void projectPairGlobal(const CameraModel& camera, const RsFrame& host, const RsF
     r.d_uv_d_T0 = Jc * dLeftAction(P0.col(k));
     r.d_uv_d_X = Jc * R_t;
     const double rho = pw.idepth[static_cast<Eigen::Index>(i)];
-    const Vec3 Z = pw.bearing.col(static_cast<Eigen::Index>(i)) / rho;
     const Eigen::Matrix<double, 2, 3> d_uv_d_Z = r.d_uv_d_X * R_w_h0;
-    r.d_uv_d_Th0 = -d_uv_d_Z * dLeftAction(Z);
     r.d_uv_d_idepth = d_uv_d_Z * Vec3(-pw.bearing.col(static_cast<Eigen::Index>(i)) / (rho * rho));
   }
 }
@@ -273,34 +272,33 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
     ol.g(3) = A * r_1;
     ol.g(4) = -r_c;
     ol.g(5) = -r_1;
-    ol.Jg.block<2, 6>(0, kColHostPose) = pr.d_uv_d_Th0;
     ol.Jg.block<2, 6>(0, kColTargetPose) = pr.d_uv_d_T0;
     ol.Jg.col(kColIdepth) = pr.d_uv_d_idepth;
     if (rolling) {
+      ol.Jg.block<2, 6>(0, kColHostPose) = pr.d_uv_d_Th0;
       ol.Jg.block<2, 6>(0, kColHostTwist) = pr.d_uv_d_xi_h;
       ol.Jg.block<2, 6>(0, kColTargetTwist) = pr.d_uv_d_xi;
       if (m.gl >= 0) ol.Jl = pr.d_uv_d_line_delay;
-    } else {
-      ol.Jg.block<2, 6>(0, kColHostTwist).setZero();
-      ol.Jg.block<2, 6>(0, kColTargetTwist).setZero();
-    }
+    }  // global shutter: the target pose and inverse depth only (accumulateChunkGlobal)
   }
 }
 
-// Accumulates the points of one chunk: their Schur data and the camera blocks. LD: the line delay is
+// Rolling shutter (global shutter: accumulateChunkGlobal below). Accumulates the points of one chunk:
+// their Schur data and the camera blocks. LD: the line delay is
 // estimated, one more geometric column (after the inverse depth) whose row goes to ChunkSums::Hl, Hll,
 // bl and, for the inverse depth, to Linearization::hpl.
 // PO (points only, BundleAdjuster::optimizeDepths): only each point's H_pp and b_p and the counts and
 // energies, no camera blocks; the same numbers as the full accumulation (bit-identical).
-template <int KD, bool LD, bool PO = false>
+template <bool LD, bool PO = false>
 void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   // Per observation, Hl = Jl^T M Jl over the N = 2 KD + 1 coordinates (host block, target block,
   // inverse depth) is formed compactly: only NG geometric columns (poses, twists when rolling, inverse
   // depth) carry d uv, and the four affine columns are selectors, so
   //   H_gg = G^T M_uu G, H_ga = G^T M_ua, H_aa = M_aa   (G: 2 x NG)
   // and then scattered into the chunk's blocks (about 5x fewer products than the dense 6 x N form).
+  constexpr int KD = 14;
   constexpr int N = 2 * KD + 1;
-  constexpr int NG0 = KD == 14 ? 25 : 13;  // poses, twists, inverse depth (index NG0 - 1)
+  constexpr int NG0 = 25;  // poses, twists, inverse depth (index NG0 - 1)
   constexpr int NG = NG0 + (LD ? 1 : 0);  // and the line delay (index NG0)
   using GM = Eigen::Matrix<double, 2, NG>;
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
@@ -320,11 +318,9 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   {
     int k = 0;
     for (int i = 0; i < 6; ++i, ++k) gidx[k] = StateLayout::kPose + i, gsrc[k] = kColHostPose + i;
-    if constexpr (KD == 14)
-      for (int i = 0; i < 6; ++i, ++k) gidx[k] = StateLayout::kTwist + i, gsrc[k] = kColHostTwist + i;
+    for (int i = 0; i < 6; ++i, ++k) gidx[k] = StateLayout::kTwist + i, gsrc[k] = kColHostTwist + i;
     for (int i = 0; i < 6; ++i, ++k) gidx[k] = KD + StateLayout::kPose + i, gsrc[k] = kColTargetPose + i;
-    if constexpr (KD == 14)
-      for (int i = 0; i < 6; ++i, ++k) gidx[k] = KD + StateLayout::kTwist + i, gsrc[k] = kColTargetTwist + i;
+    for (int i = 0; i < 6; ++i, ++k) gidx[k] = KD + StateLayout::kTwist + i, gsrc[k] = kColTargetTwist + i;
     gidx[k] = 2 * KD, gsrc[k] = kColIdepth;
   }
   constexpr int ID = NG0 - 1;  // the inverse depth's compact column
@@ -356,29 +352,20 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       for (int k = 0; k < NG0; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
       if constexpr (LD) G.col(NG0) = ol.Jl;
       MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G);
-      if constexpr (PO && KD == 14) {
+      if constexpr (PO) {
         // The inverse depth's entries alone, as the triangle below forms them.
         Hpp += G(0, ID) * MG(0, ID) + G(1, ID) * MG(1, ID);
         bg.noalias() = -G.transpose() * ol.g.template head<2>();
         bp += bg[ID];
         continue;
       }
-      if constexpr (KD == 14) {
-        // Upper triangle only (a <= c): all the rolling-shutter scatter below reads.
-        for (int a = 0; a < NG; ++a) {
-          const double g0 = G(0, a), g1 = G(1, a);
-          for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
-        }
-      } else {
-        Hgg.noalias() = G.transpose().lazyProduct(MG);
+      // Upper triangle only (a <= c): all the scatter below reads.
+      for (int a = 0; a < NG; ++a) {
+        const double g0 = G(0, a), g1 = G(1, a);
+        for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
       }
       Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
       bg.noalias() = -G.transpose() * ol.g.template head<2>();
-      if constexpr (PO) {  // global shutter
-        Hpp += Hgg(ID, ID);
-        bp += bg[ID];
-        continue;
-      }
       // Straight into the chunk's blocks: each entry of the host/target blocks receives the same one
       // addition per observation as through an N x N staging matrix (bit-identical), without writing
       // and re-reading that matrix. Local index x < KD is the host block, KD <= x < 2 KD the target's,
@@ -387,56 +374,34 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
       for (int x = 0; x < KD; ++x) row[x] = hb * KD + x, row[KD + x] = tb * KD + x;
       double* Hd = cs.H.data();
       const Eigen::Index ld = cs.H.rows();
-      auto at = [&](int x, int y) -> double& { return Hd[static_cast<Eigen::Index>(row[y]) * ld + row[x]]; };
       double hcol[N];  // column 2 KD of the local Hessian: d^2 E / d rho d x
-      if constexpr (KD == 14) {
-        // Rolling shutter (25 geometric columns): only the upper triangles of Hgg and of cs.H are
-        // formed, and linearizePhotometric mirrors cs.H's to the lower triangle once: half the
-        // products and scattered additions of the full form (the largest cost of a rolling-shutter
-        // linearisation, profiled in docs/rolling_shutter.md, "Cost").
-        for (int a = 0; a < ID; ++a) {
-          const int ga = gidx[a];
-          const int ra = row[ga];
-          for (int c = a; c < ID; ++c) {
-            const int rc = row[gidx[c]];
-            Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hgg(a, c);
-          }
-          for (int c = 0; c < 4; ++c) {
-            const int rc = row[aidx[c]];
-            Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hga(a, c);
-          }
-          hcol[ga] = Hgg(a, ID);
-          cs.b[ra] += bg[a];
-          if constexpr (LD) cs.Hl[ra] += Hgg(a, NG0);
+      // Only the upper triangles of Hgg and of cs.H are formed, and linearizePhotometric mirrors cs.H's
+      // to the lower triangle once: half the products and scattered additions of the full form (the
+      // largest cost of a rolling-shutter linearisation, profiled in docs/rolling_shutter.md, "Cost").
+      for (int a = 0; a < ID; ++a) {
+        const int ga = gidx[a];
+        const int ra = row[ga];
+        for (int c = a; c < ID; ++c) {
+          const int rc = row[gidx[c]];
+          Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hgg(a, c);
         }
-        for (int a = 0; a < 4; ++a) {
-          const int ra = row[aidx[a]];
-          for (int c = 0; c < 4; ++c) {
-            const int rc = row[aidx[c]];
-            if (ra <= rc) Hd[static_cast<Eigen::Index>(rc) * ld + ra] += ol.M(2 + a, 2 + c);
-          }
-          hcol[aidx[a]] = Hga(ID, a);
-          cs.b[ra] += -ol.g[2 + a];
-          if constexpr (LD) cs.Hl[ra] += Hga(NG0, a);
+        for (int c = 0; c < 4; ++c) {
+          const int rc = row[aidx[c]];
+          Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hga(a, c);
         }
-      } else {
-        for (int a = 0; a < ID; ++a) {
-          const int ga = gidx[a];
-          for (int c = 0; c < ID; ++c) at(ga, gidx[c]) += Hgg(a, c);
-          for (int c = 0; c < 4; ++c) {
-            at(ga, aidx[c]) += Hga(a, c);
-            at(aidx[c], ga) += Hga(a, c);
-          }
-          hcol[ga] = Hgg(a, ID);
-          cs.b[row[ga]] += bg[a];
-          if constexpr (LD) cs.Hl[row[ga]] += Hgg(a, NG0);
+        hcol[ga] = Hgg(a, ID);
+        cs.b[ra] += bg[a];
+        if constexpr (LD) cs.Hl[ra] += Hgg(a, NG0);
+      }
+      for (int a = 0; a < 4; ++a) {
+        const int ra = row[aidx[a]];
+        for (int c = 0; c < 4; ++c) {
+          const int rc = row[aidx[c]];
+          if (ra <= rc) Hd[static_cast<Eigen::Index>(rc) * ld + ra] += ol.M(2 + a, 2 + c);
         }
-        for (int a = 0; a < 4; ++a) {
-          for (int c = 0; c < 4; ++c) at(aidx[a], aidx[c]) += ol.M(2 + a, 2 + c);
-          hcol[aidx[a]] = Hga(ID, a);
-          cs.b[row[aidx[a]]] += -ol.g[2 + a];
-          if constexpr (LD) cs.Hl[row[aidx[a]]] += Hga(NG0, a);
-        }
+        hcol[aidx[a]] = Hga(ID, a);
+        cs.b[ra] += -ol.g[2 + a];
+        if constexpr (LD) cs.Hl[ra] += Hga(NG0, a);
       }
       Hpp += Hgg(ID, ID);
       bp += bg[ID];
@@ -456,6 +421,137 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
     L.hpl[static_cast<size_t>(i)] = hpl;
     L.blk_count[static_cast<size_t>(i)] = nb;
   }
+}
+
+// Global shutter: DSO's factorisation of the pose Jacobians. With left perturbations of T_c_w, a point
+// of host h seen in target t has d uv / d host pose = -(d uv / d target pose) Adj(T_t T_h^-1) exactly
+// (projectPairGlobal's two Jacobians; checked in the BA gradient tests), so each observation adds only
+// the 7 x 7 block of (target pose, inverse depth) and its affine couplings to its pair's sums, and the
+// host's blocks follow once per pair and chunk:
+//   H_hh = A^T H_tt A,  H_ht = -A^T H_tt,  H_h,x = -A^T H_t,x (x: the affine columns),  b_h = -A^T b_t.
+// About a third of the products of the 13-column form it replaced (host pose, target pose, inverse
+// depth per observation, docs/performance.md "Host blocks from the target's"); the numbers differ from
+// it by rounding only. PO: the points' H_pp and b_p only, the same numbers as the full accumulation.
+template <bool PO>
+void accumulateChunkGlobal(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
+  constexpr int KD = 8;
+  using G7 = Eigen::Matrix<double, 2, 7>;
+  ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
+  const int nk = static_cast<int>(m.window->size());
+  if constexpr (!PO) {
+    cs.H.setZero();
+    cs.b.setZero();
+    cs.Hl.setZero();
+    cs.pair_H.resize(static_cast<size_t>(nk) * nk);
+    cs.pair_b.resize(static_cast<size_t>(nk) * nk);
+    cs.pair_used.assign(static_cast<size_t>(nk) * nk, 0);
+  }
+  cs.Hll = cs.bl = 0.0;
+  cs.energy = cs.energy_in = 0.0;
+  cs.num_in = cs.num_oob = cs.num_outlier = 0;
+  const int np = static_cast<int>(m.points.size());
+  const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
+  const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+  G7 G, MG;
+  Eigen::Matrix<double, 7, 7> Hgg;
+  Eigen::Matrix<double, 7, 4> Hga;
+  Eigen::Matrix<double, 7, 1> bg;
+  for (int i = begin; i < end; ++i) {
+    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
+    const int hb = p.host->index;
+    double Hpp = 0.0, bp = 0.0;
+    const int ab = L.blk_begin[static_cast<size_t>(i)];
+    int nb = 1;
+    L.blk_ids[static_cast<size_t>(ab)] = hb;
+    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_host(L.hpc.data() + static_cast<size_t>(ab) * KD);
+    h_host.setZero();
+    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
+      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
+      cs.energy += ol.energy;
+      if (ol.state == ObsState::kOob) ++cs.num_oob;
+      if (ol.state == ObsState::kOutlier) ++cs.num_outlier;
+      if (ol.state != ObsState::kIn) continue;
+      ++cs.num_in;
+      cs.energy_in += ol.energy;
+      G.leftCols<6>() = ol.Jg.block<2, 6>(0, kColTargetPose);
+      G.col(6) = ol.Jg.col(kColIdepth);
+      MG.noalias() = ol.M.topLeftCorner<2, 2>().lazyProduct(G);
+      if constexpr (PO) {
+        Hpp += G(0, 6) * MG(0, 6) + G(1, 6) * MG(1, 6);
+        bp += -(G(0, 6) * ol.g[0] + G(1, 6) * ol.g[1]);
+        continue;
+      }
+      Hgg.noalias() = G.transpose().lazyProduct(MG);
+      Hga.noalias() = G.transpose().lazyProduct(ol.M.topRightCorner<2, 4>());
+      bg.noalias() = -G.transpose() * ol.g.head<2>();
+      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
+      const size_t pi = static_cast<size_t>(hb) * nk + tb;
+      Eigen::Matrix<double, 10, 10>& S = cs.pair_H[pi];
+      Eigen::Matrix<double, 10, 1>& sb = cs.pair_b[pi];
+      if (!cs.pair_used[pi]) {
+        S.setZero();
+        sb.setZero();
+        cs.pair_used[pi] = 1;
+      }
+      S.topLeftCorner<6, 6>() += Hgg.topLeftCorner<6, 6>();
+      S.block<6, 4>(0, 6) += Hga.topRows<6>();
+      S.bottomRightCorner<4, 4>() += ol.M.bottomRightCorner<4, 4>();
+      sb.head<6>() += bg.head<6>();
+      sb.tail<4>() -= ol.g.tail<4>();
+      Hpp += Hgg(6, 6);
+      bp += bg[6];
+      // The point's coupling to its host block (pose through the adjoint, affine (a_h, b_h)) and to the
+      // target block (pose, affine (a_t, b_t)).
+      const Eigen::Matrix<double, 6, 6>& A = L.pair_adj[pi];
+      h_host.head<6>().noalias() -= A.transpose() * Hgg.col(6).head<6>();
+      h_host.tail<2>() += Hga.row(6).head<2>().transpose();
+      L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
+      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t(L.hpc.data() + static_cast<size_t>(ab + nb) * KD);
+      h_t.head<6>() = Hgg.col(6).head<6>();
+      h_t.tail<2>() = Hga.row(6).tail<2>().transpose();
+      ++nb;
+    }
+    L.Hpp[static_cast<size_t>(i)] = Hpp;
+    L.bp[static_cast<size_t>(i)] = bp;
+    L.hpl[static_cast<size_t>(i)] = 0.0;
+    L.blk_count[static_cast<size_t>(i)] = nb;
+  }
+  if constexpr (PO) return;
+  // The pairs' sums into the chunk's camera blocks (state order per block: pose 0-5, affine 6-7).
+  for (int h = 0; h < nk; ++h)
+    for (int t = 0; t < nk; ++t) {
+      const size_t pi = static_cast<size_t>(h) * nk + t;
+      if (!cs.pair_used[pi]) continue;
+      const Eigen::Matrix<double, 10, 10>& S = cs.pair_H[pi];
+      const Eigen::Matrix<double, 10, 1>& sb = cs.pair_b[pi];
+      const Eigen::Matrix<double, 6, 6>& A = L.pair_adj[pi];
+      const Eigen::Matrix<double, 6, 6> S_tt = S.topLeftCorner<6, 6>();
+      const Eigen::Matrix<double, 6, 6> AtS = A.transpose() * S_tt;  // A^T H_tt
+      const int oh = h * KD, ot = t * KD;
+      const Eigen::Matrix<double, 6, 6> H_hh = AtS * A;
+      cs.H.block<6, 6>(oh, oh) += 0.5 * (H_hh + H_hh.transpose());  // symmetric to the last bit
+      cs.H.block<6, 6>(oh, ot) -= AtS;
+      cs.H.block<6, 6>(ot, oh) -= AtS.transpose();
+      cs.H.block<6, 6>(ot, ot) += S_tt;
+      // Pose-affine couplings: columns 6-7 of S are the host's affine, 8-9 the target's.
+      const Eigen::Matrix<double, 6, 4> S_ta = S.block<6, 4>(0, 6);
+      const Eigen::Matrix<double, 6, 4> H_ha = -(A.transpose() * S_ta);
+      for (int side = 0; side < 2; ++side) {
+        const int oa = (side == 0 ? oh : ot) + StateLayout::kAffine;
+        cs.H.block<6, 2>(oh, oa) += H_ha.middleCols<2>(2 * side);
+        cs.H.block<2, 6>(oa, oh) += H_ha.middleCols<2>(2 * side).transpose();
+        cs.H.block<6, 2>(ot, oa) += S_ta.middleCols<2>(2 * side);
+        cs.H.block<2, 6>(oa, ot) += S_ta.middleCols<2>(2 * side).transpose();
+      }
+      for (int sa = 0; sa < 2; ++sa)
+        for (int sc = 0; sc < 2; ++sc)
+          cs.H.block<2, 2>((sa == 0 ? oh : ot) + StateLayout::kAffine, (sc == 0 ? oh : ot) + StateLayout::kAffine) +=
+              S.block<2, 2>(6 + 2 * sa, 6 + 2 * sc);
+      cs.b.segment<6>(ot) += sb.head<6>();
+      cs.b.segment<6>(oh).noalias() -= A.transpose() * sb.head<6>();
+      cs.b.segment<2>(oh + StateLayout::kAffine) += sb.segment<2>(6);
+      cs.b.segment<2>(ot + StateLayout::kAffine) += sb.segment<2>(8);
+    }
 }
 
 }  // namespace
@@ -485,6 +581,11 @@ void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundle
       }
     });
   }
+  if (!cfg.layout.rolling) {  // accumulateChunkGlobal's host-pose map, from the states evaluated here
+    L.pair_adj.resize(m.pairs.size());
+    for (size_t i = 0; i < m.pairs.size(); ++i)
+      L.pair_adj[i] = (m.pairs[i].target->state.T_c_w * m.pairs[i].host->state.T_c_w.inverse()).Adj();
+  }
   m.runner->run(static_cast<int>(m.pairs.size()),
                 [&](int i) { evaluatePair(m, m.pairs[static_cast<size_t>(i)], L, cfg, camera, m.timing, kernel); });
 }
@@ -509,9 +610,9 @@ void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bund
                            bool points_only) {
   if (points_only) {
     if (cfg.layout.rolling)
-      m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, false, true>(m, L, c); });
+      m.runner->run(kPointChunks, [&](int c) { accumulateChunk<false, true>(m, L, c); });
     else
-      m.runner->run(kPointChunks, [&](int c) { accumulateChunk<8, false, true>(m, L, c); });
+      m.runner->run(kPointChunks, [&](int c) { accumulateChunkGlobal<true>(m, L, c); });
     L.energy_photo = L.energy_photo_in = 0.0;
     L.num_in = L.num_oob = L.num_outlier = 0;
     for (const ChunkSums& c : m.chunks) {
@@ -524,11 +625,11 @@ void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bund
     return;
   }
   if (m.gl >= 0) {
-    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, true>(m, L, c); });
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<true>(m, L, c); });
   } else if (cfg.layout.rolling) {
-    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<14, false>(m, L, c); });
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<false>(m, L, c); });
   } else {
-    m.runner->run(kPointChunks, [&](int c) { accumulateChunk<8, false>(m, L, c); });
+    m.runner->run(kPointChunks, [&](int c) { accumulateChunkGlobal<false>(m, L, c); });
   }
   L.Hcc.setZero(m.nc, m.nc);
   L.bc.setZero(m.nc);
@@ -549,7 +650,7 @@ void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bund
     L.num_oob += c.num_oob;
     L.num_outlier += c.num_outlier;
   }
-  // Rolling shutter: the chunks wrote the upper triangle only (accumulateChunk<14>).
+  // Rolling shutter: the chunks wrote the upper triangle only (accumulateChunk).
   if (cfg.layout.rolling) {
     for (Eigen::Index j = 0; j < m.nkd; ++j)
       for (Eigen::Index i = j + 1; i < m.nkd; ++i) L.Hcc(i, j) = L.Hcc(j, i);

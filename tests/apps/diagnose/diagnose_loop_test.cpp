@@ -280,10 +280,12 @@ TEST(DiagnoseLoop, CleanDataGivesNone) {
 // A run that fails part way is diagnosed from what it wrote, and says how much data it had.
 TEST(DiagnoseLoop, FailedRunIsDiagnosedAndSaysHowMuchDataItHad) {
   const fs::path dir = workDir("failed");
-  // Vignetting, seed 3: gs_vo loses track part way (measured: frame 51 of 57) when the window iterates
-  // fully; gs_vo.json's small-step stop tracks it through, so the test turns the stop off.
-  simulate(dir / "data", 3, kVignette);
-  const nlohmann::json rep = run(dir / "data", dir / "run", "--set backend.min_step_rad=0");
+  // Vignetting, seed 5: gs_vo loses track before the end (measured 2026-12-06: at frame 56 of 57, with
+  // and without the small-step stop). Which seed fails moves with the rounding of the bundle
+  // adjustment: seed 3, used before, failed at frame 51 until the global-shutter host blocks came from
+  // the target's (docs/performance.md); of seeds 1-8 only 5 fails now.
+  simulate(dir / "data", 5, kVignette);
+  const nlohmann::json rep = run(dir / "data", dir / "run", "");
   ASSERT_EQ(rep.value("status", ""), "failed") << rep.dump(1);
   std::string text;
   ASSERT_EQ(rsvio("diagnose --run " + (dir / "run").string(), &text), 0);

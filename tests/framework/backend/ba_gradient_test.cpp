@@ -181,6 +181,59 @@ void checkGradient(bool rolling, bool single_target = false, bool line_delay_est
 }
 
 TEST(BundleAdjustmentGradient, GlobalShutterMatchesNumericDifferences) { checkGradient(false); }
+
+// The global-shutter accumulation forms a host's blocks from its targets' through the pair's adjoint
+// (ba_linearize.cpp, accumulateChunkGlobal); the rolling-shutter accumulation forms every block from
+// the general projection's own host Jacobians. With no readout (line delay 0, zero twists) both describe
+// the same energy, so every entry of the full system (cameras, camera-point couplings, points) must
+// agree to rounding. The gradient test above sees b only; this sees H. Shown once: the host-target
+// block formed with A instead of A^T fails 144 entries, the host's pose-affine couplings left out 144.
+TEST(BundleAdjustmentGradient, GlobalShutterSystemEqualsTheRollingPathWithoutReadout) {
+  test::TestWindow w(3, false);
+  w.addPoints(0, 150);
+  w.addPoints(1, 100, 5);
+  w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
+  w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
+  w.window[1]->state.affine.a = 0.05;
+  w.window[2]->state.affine.b = 3.0;
+  for (auto& kf : w.window)
+    for (ActivePoint& p : kf->points) p.idepth *= 1.02;
+  auto solver = test::makePlugin<SolverBackend>("solver.dense");
+  MarginalizationPrior prior_gs(StateLayout{}), prior_rs([] {
+    StateLayout l;
+    l.rolling = true;
+    return l;
+  }());
+  Eigen::MatrixXd H[2];
+  Eigen::VectorXd b[2];
+  for (int rolling = 0; rolling < 2; ++rolling) {
+    BundleAdjustmentConfig cfg;
+    cfg.layout.rolling = rolling == 1;
+    cfg.twist_regularization = 0.0;
+    const RowTiming timing = rolling ? RowTiming::rolling(w.timing.y0, 0.0, true) : w.timing;
+    BundleAdjuster ba(cfg, w.camera, timing, *solver);
+    ba.linearize(w.window, rolling ? prior_rs : prior_gs);
+    ba.fullSystem(&H[rolling], &b[rolling]);
+  }
+  // Global-shutter index -> rolling-shutter index (keyframe blocks 8 -> 14: pose, affine, then twist).
+  const int ncg = 3 * 8, ncr = 3 * 14;
+  const Eigen::Index np = H[0].rows() - ncg;
+  ASSERT_EQ(H[1].rows() - ncr, np);
+  ASSERT_GT(np, 100);
+  auto map = [&](Eigen::Index i) { return i < ncg ? (i / 8) * 14 + i % 8 : i - ncg + ncr; };
+  // Each entry against the largest of its row and column (a block's own scale), to 1e-9.
+  const Eigen::VectorXd rowmax = H[0].cwiseAbs().rowwise().maxCoeff();
+  int bad = 0;
+  for (Eigen::Index i = 0; i < H[0].rows(); ++i) {
+    for (Eigen::Index j = 0; j < H[0].cols(); ++j) {
+      const double tol = 1e-9 * std::max(rowmax[i], rowmax[j]) + 1e-12;
+      if (std::abs(H[0](i, j) - H[1](map(i), map(j))) > tol) ++bad;
+    }
+    if (std::abs(b[0][i] - b[1][map(i)]) > 1e-9 * b[0].cwiseAbs().maxCoeff()) ++bad;
+  }
+  EXPECT_EQ(bad, 0);
+  EXPECT_GT(H[0].topLeftCorner(8, 8).norm(), 0.0);  // the host keyframe's block is not empty
+}
 TEST(BundleAdjustmentGradient, RollingShutterMatchesNumericDifferences) { checkGradient(true); }
 TEST(BundleAdjustmentGradient, GlobalShutterSingleTargetEachBlockAtItsOwnScale) { checkGradient(false, true); }
 TEST(BundleAdjustmentGradient, RollingShutterSingleTargetEachBlockAtItsOwnScale) { checkGradient(true, true); }
