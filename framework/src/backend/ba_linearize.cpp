@@ -283,6 +283,27 @@ void evaluatePair(BundleAdjuster::Impl& m, PairWork& pw, Linearization& L, const
   }
 }
 
+// The chunk's points [begin, end), with its line-delay sums, energies and counters reset.
+std::pair<int, int> startChunk(const BundleAdjuster::Impl& m, ChunkSums& cs, int chunk) {
+  cs.Hll = cs.bl = 0.0;
+  cs.energy = cs.energy_in = 0.0;
+  cs.num_in = cs.num_oob = cs.num_outlier = 0;
+  const int np = static_cast<int>(m.points.size());
+  return {static_cast<int>(static_cast<long>(np) * chunk / kPointChunks),
+          static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks)};
+}
+
+// Counts one observation into the chunk's energies and counters; true for an inlier (it has blocks).
+bool countObservation(ChunkSums& cs, const ObsLin& ol) {
+  cs.energy += ol.energy;
+  if (ol.state == ObsState::kOob) ++cs.num_oob;
+  if (ol.state == ObsState::kOutlier) ++cs.num_outlier;
+  if (ol.state != ObsState::kIn) return false;
+  ++cs.num_in;
+  cs.energy_in += ol.energy;
+  return true;
+}
+
 // Rolling shutter (global shutter: accumulateChunkGlobal below). Accumulates the points of one chunk:
 // their Schur data and the camera blocks. LD: the line delay is
 // estimated, one more geometric column (after the inverse depth) whose row goes to ChunkSums::Hl, Hll,
@@ -307,12 +328,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
     cs.b.setZero();
     cs.Hl.setZero();
   }
-  cs.Hll = cs.bl = 0.0;
-  cs.energy = cs.energy_in = 0.0;
-  cs.num_in = cs.num_oob = cs.num_outlier = 0;
-  const int np = static_cast<int>(m.points.size());
-  const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
-  const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+  const auto [begin, end] = startChunk(m, cs, chunk);
   // Where the compact columns go in Hl, and where they come from in ObsLin::Jg.
   int gidx[NG], gsrc[NG];
   {
@@ -342,12 +358,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
     h_host.setZero();
     for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
       const ObsLin& ol = L.obs[static_cast<size_t>(r)];
-      cs.energy += ol.energy;
-      if (ol.state == ObsState::kOob) ++cs.num_oob;
-      if (ol.state == ObsState::kOutlier) ++cs.num_outlier;
-      if (ol.state != ObsState::kIn) continue;
-      ++cs.num_in;
-      cs.energy_in += ol.energy;
+      if (!countObservation(cs, ol)) continue;
       const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
       for (int k = 0; k < NG0; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
       if constexpr (LD) G.col(NG0) = ol.Jl;
@@ -446,12 +457,7 @@ void accumulateChunkGlobal(BundleAdjuster::Impl& m, Linearization& L, int chunk)
     cs.pair_b.resize(static_cast<size_t>(nk) * nk);
     cs.pair_used.assign(static_cast<size_t>(nk) * nk, 0);
   }
-  cs.Hll = cs.bl = 0.0;
-  cs.energy = cs.energy_in = 0.0;
-  cs.num_in = cs.num_oob = cs.num_outlier = 0;
-  const int np = static_cast<int>(m.points.size());
-  const int begin = static_cast<int>(static_cast<long>(np) * chunk / kPointChunks);
-  const int end = static_cast<int>(static_cast<long>(np) * (chunk + 1) / kPointChunks);
+  const auto [begin, end] = startChunk(m, cs, chunk);
   G7 G, MG;
   Eigen::Matrix<double, 7, 7> Hgg;
   Eigen::Matrix<double, 7, 4> Hga;
@@ -467,12 +473,7 @@ void accumulateChunkGlobal(BundleAdjuster::Impl& m, Linearization& L, int chunk)
     h_host.setZero();
     for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
       const ObsLin& ol = L.obs[static_cast<size_t>(r)];
-      cs.energy += ol.energy;
-      if (ol.state == ObsState::kOob) ++cs.num_oob;
-      if (ol.state == ObsState::kOutlier) ++cs.num_outlier;
-      if (ol.state != ObsState::kIn) continue;
-      ++cs.num_in;
-      cs.energy_in += ol.energy;
+      if (!countObservation(cs, ol)) continue;
       G.leftCols<6>() = ol.Jg.block<2, 6>(0, kColTargetPose);
       G.col(6) = ol.Jg.col(kColIdepth);
       MG.noalias() = ol.M.topLeftCorner<2, 2>().lazyProduct(G);
