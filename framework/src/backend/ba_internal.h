@@ -59,8 +59,10 @@ struct Linearization {
   std::vector<int> blk_begin, blk_count;  // per point: involved blocks in the arena
   std::vector<int> blk_ids;             // window indices (host first)
   std::vector<double> hpc;              // kfDim values per arena entry: d^2 E / d rho d x_block
-  // Global shutter: per pair (h * nk + t), Adj(T_t T_h^-1) of the evaluated states, with which
-  // d uv / d host pose = -d uv / d target pose * Adj (left perturbations of T_c_w, lie.h).
+  // Per pair (h * nk + t), Adj(T_t T_h^-1) of the evaluated (central) poses, with which
+  // d uv / d host pose = -d uv / d target pose * Adj (left perturbations of T_c_w, lie.h), for a
+  // global and a rolling shutter alike (ba_linearize.cpp, accumulateChunkGlobal and
+  // accumulateChunkRolling).
   std::vector<Eigen::Matrix<double, 6, 6>> pair_adj;
   Eigen::MatrixXd Hcc;                  // cameras: photometric + priors + terms, undamped, unmasked
   Eigen::VectorXd bc;
@@ -84,6 +86,11 @@ struct ChunkSums {
   std::vector<Eigen::Matrix<double, 10, 10>> pair_H;
   std::vector<Eigen::Matrix<double, 10, 1>> pair_b;
   std::vector<uint8_t> pair_used;
+  // Rolling shutter (accumulateChunkRolling): per pair, the upper triangles of the normal equations
+  // over (target pose 6, host twist 6, target twist 6, line delay 1, host affine 2, target affine 2);
+  // added over the chunks and mapped to the window's blocks by addRollingPairs (H, b, Hl stay unused).
+  std::vector<Eigen::Matrix<double, 23, 23>> pair_Hr;
+  std::vector<Eigen::Matrix<double, 23, 1>> pair_br;
   double energy = 0.0, energy_in = 0.0;
   int num_in = 0, num_oob = 0, num_outlier = 0;
 };

@@ -434,6 +434,172 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   }
 }
 
+// Rolling shutter, the host pose's blocks from the target pose's. The global-shutter identity below
+// holds with twists too: host and target move as T_c_w(t) = exp(xi t) T_c_w^0 (rs_projection.h), so
+// the target pixel depends on the two central poses only through T_t^0 (T_h^0)^-1 (the host row's
+// exponential multiplies it on the right, the target row's on the left, and the target row's implicit
+// solve sees the same product); left perturbations then give, at any row times and line delay,
+//   d uv / d host pose = -(d uv / d target pose) A,   A = Adj(T_t^0 (T_h^0)^-1)
+// (checked against the projection's own host Jacobian in tests/framework/geometry and, as whole
+// systems, against accumulateChunk in BundleAdjustmentGradient). Per observation: the compact
+// columns (target pose 0-5, host twist 6-11, target twist 12-17, inverse depth 18, line delay 19 when
+// it is estimated): 19 or 20 instead of accumulateChunk's 25 or 26, into the pair's sums over
+// y = (target pose, host twist, target twist, line delay, host affine, target affine); once per pair,
+// after the chunks (addRollingPairs), the host pose follows with B: y -> z = (host pose, y), J_z = J_y B:
+//   H_hh = A^T S_tt A,  H_h,y = -A^T S_t,y,  H_yy = S,  b_h = -A^T b_t.
+// Only upper triangles are formed (S and L.Hcc), as in accumulateChunk. The numbers differ from
+// accumulateChunk's by rounding only.
+template <bool LD>
+void accumulateChunkRolling(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
+  constexpr int KD = 14;
+  constexpr int NY = 23, YL = 18, YA = 19;  // pair sums; the line delay's and the first affine index
+  constexpr int ID = 18;                    // the inverse depth's compact column
+  constexpr int NG = ID + 1 + (LD ? 1 : 0);
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
+  const int nk = static_cast<int>(m.window->size());
+  cs.pair_Hr.resize(static_cast<size_t>(nk) * nk);
+  cs.pair_br.resize(static_cast<size_t>(nk) * nk);
+  cs.pair_used.assign(static_cast<size_t>(nk) * nk, 0);
+  const auto [begin, end] = startChunk(m, cs, chunk);
+  int gsrc[ID];
+  for (int i = 0; i < 6; ++i)
+    gsrc[i] = kColTargetPose + i, gsrc[6 + i] = kColHostTwist + i, gsrc[12 + i] = kColTargetTwist + i;
+  auto yOf = [](int a) { return a < ID ? a : YL; };  // compact column (not the inverse depth) -> y
+  Eigen::Matrix<double, 2, NG> G, MG;
+  Eigen::Matrix<double, NG, NG> Hgg;
+  Eigen::Matrix<double, NG, 4> Hga;
+  Eigen::Matrix<double, NG, 1> bg;
+  for (int i = begin; i < end; ++i) {
+    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
+    const int hb = p.host->index;
+    double Hpp = 0.0, bp = 0.0, hpl = 0.0;
+    const int ab = L.blk_begin[static_cast<size_t>(i)];
+    int nb = 1;
+    L.blk_ids[static_cast<size_t>(ab)] = hb;
+    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_host(L.hpc.data() + static_cast<size_t>(ab) * KD);
+    h_host.setZero();
+    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
+      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
+      if (!countObservation(cs, ol)) continue;
+      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
+      for (int k = 0; k < ID; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
+      G.col(ID) = ol.Jg.col(kColIdepth);
+      if constexpr (LD) G.col(ID + 1) = ol.Jl;
+      MG.noalias() = ol.M.topLeftCorner<2, 2>().lazyProduct(G);
+      for (int a = 0; a < NG; ++a) {  // upper triangle (a <= c)
+        const double g0 = G(0, a), g1 = G(1, a);
+        for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
+      }
+      Hga.noalias() = G.transpose().lazyProduct(ol.M.topRightCorner<2, 4>());
+      bg.noalias() = -G.transpose() * ol.g.head<2>();
+      const size_t pi = static_cast<size_t>(hb) * nk + tb;
+      Eigen::Matrix<double, NY, NY>& S = cs.pair_Hr[pi];
+      Eigen::Matrix<double, NY, 1>& sb = cs.pair_br[pi];
+      if (!cs.pair_used[pi]) {
+        S.setZero();
+        sb.setZero();
+        cs.pair_used[pi] = 1;
+      }
+      for (int a = 0; a < NG; ++a) {
+        if (a == ID) continue;
+        const int ya = yOf(a);  // yOf keeps the order, so S gets its upper triangle
+        for (int c = a; c < NG; ++c)
+          if (c != ID) S(ya, yOf(c)) += Hgg(a, c);
+        for (int c = 0; c < 4; ++c) S(ya, YA + c) += Hga(a, c);
+        sb[ya] += bg[a];
+      }
+      for (int a = 0; a < 4; ++a) {
+        for (int c = a; c < 4; ++c) S(YA + a, YA + c) += ol.M(2 + a, 2 + c);
+        sb[YA + a] -= ol.g[2 + a];
+      }
+      Hpp += Hgg(ID, ID);
+      bp += bg[ID];
+      if constexpr (LD) hpl += Hgg(ID, ID + 1);
+      // The point's coupling to its host block (pose through the adjoint, twist, affine (a_h, b_h))
+      // and to the target block (pose, twist, affine (a_t, b_t)).
+      Eigen::Matrix<double, ID, 1> hc;  // d^2 E / d rho d (target pose, host twist, target twist)
+      for (int k = 0; k < ID; ++k) hc[k] = Hgg(k, ID);
+      const Eigen::Vector4d ha = Hga.row(ID).transpose();
+      const Mat6& A = L.pair_adj[pi];
+      h_host.segment<6>(StateLayout::kPose).noalias() -= A.transpose() * hc.head<6>();
+      h_host.segment<6>(StateLayout::kTwist) += hc.segment<6>(6);
+      h_host.segment<2>(StateLayout::kAffine) += ha.head<2>();
+      L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
+      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t(L.hpc.data() + static_cast<size_t>(ab + nb) * KD);
+      h_t.segment<6>(StateLayout::kPose) = hc.head<6>();
+      h_t.segment<6>(StateLayout::kTwist) = hc.segment<6>(12);
+      h_t.segment<2>(StateLayout::kAffine) = ha.tail<2>();
+      ++nb;
+    }
+    L.Hpp[static_cast<size_t>(i)] = Hpp;
+    L.bp[static_cast<size_t>(i)] = bp;
+    L.hpl[static_cast<size_t>(i)] = hpl;
+    L.blk_count[static_cast<size_t>(i)] = nb;
+  }
+}
+
+// accumulateChunkRolling's pair sums, added over the chunks in chunk order, into L.Hcc and L.bc (upper
+// triangle; L.Hcc and L.bc zero on entry): once per pair and linearisation, not per chunk, and the
+// chunks carry no window-sized blocks to clear and add.
+void addRollingPairs(const BundleAdjuster::Impl& m, Linearization& L) {
+  constexpr int KD = 14, NY = 23, YL = 18;
+  constexpr int NZ = 6 + NY, ZL = 6 + YL;  // z = (host pose, y); the line delay's index in z
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  const int nk = static_cast<int>(m.window->size());
+  double* Hd = L.Hcc.data();
+  const Eigen::Index ld = L.Hcc.rows();
+  Eigen::Matrix<double, NY, NY> S;
+  Eigen::Matrix<double, NY, 1> sb;
+  Eigen::Matrix<double, NZ, NZ> Z;
+  Eigen::Matrix<double, NZ, 1> zb;
+  for (int h = 0; h < nk; ++h)
+    for (int t = 0; t < nk; ++t) {
+      const size_t pi = static_cast<size_t>(h) * nk + t;
+      bool used = false;
+      for (const ChunkSums& c : m.chunks) {
+        if (!c.pair_used[pi]) continue;
+        if (used) {
+          S += c.pair_Hr[pi];
+          sb += c.pair_br[pi];
+        } else {
+          S = c.pair_Hr[pi];
+          sb = c.pair_br[pi];
+          used = true;
+        }
+      }
+      if (!used) continue;
+      const Eigen::Matrix<double, NY, NY> F = S.selfadjointView<Eigen::Upper>();
+      const Mat6& A = L.pair_adj[pi];
+      const Eigen::Matrix<double, 6, NY> H_hy = -(A.transpose() * F.topRows<6>());
+      Z.topLeftCorner<6, 6>().noalias() = -(H_hy.leftCols<6>() * A);
+      Z.topRightCorner<6, NY>() = H_hy;
+      Z.bottomRightCorner<NY, NY>() = F;
+      zb.head<6>().noalias() = -(A.transpose() * sb.head<6>());
+      zb.tail<NY>() = sb;
+      const int oh = h * KD, ot = t * KD;
+      int zr[NZ];
+      for (int k = 0; k < 6; ++k) {
+        zr[k] = oh + StateLayout::kPose + k;
+        zr[6 + k] = ot + StateLayout::kPose + k;
+        zr[12 + k] = oh + StateLayout::kTwist + k;
+        zr[18 + k] = ot + StateLayout::kTwist + k;
+      }
+      zr[ZL] = m.gl;  // the line delay's camera dimension (after every keyframe's), or -1
+      for (int k = 0; k < 2; ++k) zr[ZL + 1 + k] = oh + StateLayout::kAffine + k, zr[ZL + 3 + k] = ot + StateLayout::kAffine + k;
+      for (int a = 0; a < NZ; ++a) {
+        const int ra = zr[a];
+        if (ra < 0) continue;
+        for (int c = a; c < NZ; ++c) {
+          const int rc = zr[c];
+          if (rc < 0) continue;
+          Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Z(a, c);
+        }
+        L.bc[ra] += zb[a];
+      }
+    }
+}
+
 // Global shutter: DSO's factorisation of the pose Jacobians. With left perturbations of T_c_w, a point
 // of host h seen in target t has d uv / d host pose = -(d uv / d target pose) Adj(T_t T_h^-1) exactly
 // (projectPairGlobal's two Jacobians; checked in the BA gradient tests), so each observation adds only
@@ -582,7 +748,7 @@ void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bundle
       }
     });
   }
-  if (!cfg.layout.rolling) {  // accumulateChunkGlobal's host-pose map, from the states evaluated here
+  if (!cfg.layout.rolling || cfg.host_blocks_from_adjoint) {  // the host-pose map, from the states evaluated here
     L.pair_adj.resize(m.pairs.size());
     for (size_t i = 0; i < m.pairs.size(); ++i)
       L.pair_adj[i] = (m.pairs[i].target->state.T_c_w * m.pairs[i].host->state.T_c_w.inverse()).Adj();
@@ -625,7 +791,13 @@ void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bund
     }
     return;
   }
-  if (m.gl >= 0) {
+  const bool pairs = cfg.layout.rolling && cfg.host_blocks_from_adjoint;  // accumulateChunkRolling
+  if (pairs) {
+    if (m.gl >= 0)
+      m.runner->run(kPointChunks, [&](int c) { accumulateChunkRolling<true>(m, L, c); });
+    else
+      m.runner->run(kPointChunks, [&](int c) { accumulateChunkRolling<false>(m, L, c); });
+  } else if (m.gl >= 0) {
     m.runner->run(kPointChunks, [&](int c) { accumulateChunk<true>(m, L, c); });
   } else if (cfg.layout.rolling) {
     m.runner->run(kPointChunks, [&](int c) { accumulateChunk<false>(m, L, c); });
@@ -637,13 +809,15 @@ void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bund
   L.energy_photo = L.energy_photo_in = 0.0;
   L.num_in = L.num_oob = L.num_outlier = 0;
   for (const ChunkSums& c : m.chunks) {  // fixed order: deterministic
-    L.Hcc.topLeftCorner(m.nkd, m.nkd) += c.H;
-    L.bc.head(m.nkd) += c.b;
-    if (m.gl >= 0) {
-      L.Hcc.col(m.gl).head(m.nkd) += c.Hl;
-      L.Hcc.row(m.gl).head(m.nkd) += c.Hl.transpose();
-      L.Hcc(m.gl, m.gl) += c.Hll;
-      L.bc[m.gl] += c.bl;
+    if (!pairs) {
+      L.Hcc.topLeftCorner(m.nkd, m.nkd) += c.H;
+      L.bc.head(m.nkd) += c.b;
+      if (m.gl >= 0) {
+        L.Hcc.col(m.gl).head(m.nkd) += c.Hl;
+        L.Hcc.row(m.gl).head(m.nkd) += c.Hl.transpose();
+        L.Hcc(m.gl, m.gl) += c.Hll;
+        L.bc[m.gl] += c.bl;
+      }
     }
     L.energy_photo += c.energy;
     L.energy_photo_in += c.energy_in;
@@ -651,10 +825,13 @@ void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const Bund
     L.num_oob += c.num_oob;
     L.num_outlier += c.num_outlier;
   }
-  // Rolling shutter: the chunks wrote the upper triangle only (accumulateChunk).
+  if (pairs) addRollingPairs(m, L);
+  // Rolling shutter: the upper triangle only was formed (accumulateChunk, addRollingPairs; the latter's
+  // line-delay row too).
   if (cfg.layout.rolling) {
     for (Eigen::Index j = 0; j < m.nkd; ++j)
       for (Eigen::Index i = j + 1; i < m.nkd; ++i) L.Hcc(i, j) = L.Hcc(j, i);
+    if (pairs && m.gl >= 0) L.Hcc.row(m.gl).head(m.nkd) = L.Hcc.col(m.gl).head(m.nkd).transpose();
   }
 }
 

@@ -28,6 +28,10 @@ ParamTable backendParamTable() {
       paramBool("accept_all_steps", d.accept_all_steps,
                 "take every Levenberg-Marquardt step, also one that raises the energy (DSO's setting_forceAceptStep); "
                 "the iterations then end on max_iterations or min_step_rad only"),
+      paramBool("host_blocks_from_adjoint", d.host_blocks_from_adjoint,
+                "rolling shutter: form each host pose's normal-equation blocks from its targets' through the pair's "
+                "adjoint (false: accumulate every observation's own host-pose Jacobian, the slower reference; the "
+                "same system to rounding; docs/rolling_shutter.md, Cost)"),
       paramDouble("min_step_rad", d.min_step_rad, 0.0, 1.0, "rad",
                   "stop iterating after an accepted step whose RMS keyframe rotation and RMS translation x mean "
                   "inverse depth are both below this (DSO's test, 6e-5 there) and whose inverse-depth steps are "
@@ -108,6 +112,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.step_threshold = p.getDouble("step_threshold");
   o.max_rejected_steps = static_cast<int>(p.getInt("max_rejected_steps"));
   o.accept_all_steps = p.getBool("accept_all_steps");
+  o.host_blocks_from_adjoint = p.getBool("host_blocks_from_adjoint");
   o.min_step_rad = p.getDouble("min_step_rad");
   o.min_step_idepth = p.getDouble("min_step_idepth");
   o.marg_weight_factor = p.getDouble("marg_weight_factor");

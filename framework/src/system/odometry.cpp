@@ -79,6 +79,7 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   bc.step_threshold = bo.step_threshold;
   bc.max_rejected_steps = bo.max_rejected_steps;
   bc.accept_all_steps = bo.accept_all_steps;
+  bc.host_blocks_from_adjoint = bo.host_blocks_from_adjoint;
   bc.min_step_rad = bo.min_step_rad;
   bc.min_step_idepth = bo.min_step_idepth;
   bc.twist_regularization = bo.twist_regularization;

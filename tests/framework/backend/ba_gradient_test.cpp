@@ -184,7 +184,7 @@ TEST(BundleAdjustmentGradient, GlobalShutterMatchesNumericDifferences) { checkGr
 
 // The global-shutter accumulation forms a host's blocks from its targets' through the pair's adjoint
 // (ba_linearize.cpp, accumulateChunkGlobal); the rolling-shutter accumulation forms every block from
-// the general projection's own host Jacobians. With no readout (line delay 0, zero twists) both describe
+// the general projection's own host Jacobians (host_blocks_from_adjoint off). With no readout (line delay 0, zero twists) both describe
 // the same energy, so every entry of the full system (cameras, camera-point couplings, points) must
 // agree to rounding. The gradient test above sees b only; this sees H. Shown once: the host-target
 // block formed with A instead of A^T fails 144 entries, the host's pose-affine couplings left out 144.
@@ -209,6 +209,7 @@ TEST(BundleAdjustmentGradient, GlobalShutterSystemEqualsTheRollingPathWithoutRea
   for (int rolling = 0; rolling < 2; ++rolling) {
     BundleAdjustmentConfig cfg;
     cfg.layout.rolling = rolling == 1;
+    cfg.host_blocks_from_adjoint = false;
     cfg.twist_regularization = 0.0;
     const RowTiming timing = rolling ? RowTiming::rolling(w.timing.y0, 0.0, true) : w.timing;
     BundleAdjuster ba(cfg, w.camera, timing, *solver);
@@ -233,6 +234,63 @@ TEST(BundleAdjustmentGradient, GlobalShutterSystemEqualsTheRollingPathWithoutRea
   }
   EXPECT_EQ(bad, 0);
   EXPECT_GT(H[0].topLeftCorner(8, 8).norm(), 0.0);  // the host keyframe's block is not empty
+}
+// The rolling-shutter accumulation forms the host pose's blocks from the target pose's through the
+// pair's adjoint too (ba_linearize.cpp, accumulateChunkRolling): with readout, non-zero twists and the
+// line delay fixed or estimated, its full system (cameras, the line delay's row, camera-point
+// couplings, points) equals that of the explicit host-pose Jacobians (accumulateChunk) to rounding.
+// Shown once: the host's rows formed with A instead of A^T (H_h,y = -A S_t,y) fail 864 and 888
+// entries, the line delay's coupling to the host pose left out 24 (the estimated delay's test only).
+void checkRollingSystemFromAdjoint(bool line_delay_estimated) {
+  const double line_delay = 30e-3 / 256;
+  test::TestWindow w(3, true, line_delay, 1.0, 0.05);
+  w.addPoints(0, 150);
+  w.addPoints(1, 100, 5);
+  w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
+  w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
+  w.window[1]->state.affine.a = 0.05;
+  w.window[2]->state.affine.b = 3.0;
+  for (auto& kf : w.window) kf->state.twist += test::tw(0.2, -0.2, 0.1, 0.1, 0.1, -0.1);
+  for (auto& kf : w.window)
+    for (ActivePoint& p : kf->points) p.idepth *= 1.02;
+  auto solver = test::makePlugin<SolverBackend>("solver.dense");
+  Eigen::MatrixXd H[2];
+  Eigen::VectorXd b[2];
+  for (int adjoint = 0; adjoint < 2; ++adjoint) {
+    BundleAdjustmentConfig cfg;
+    cfg.layout.rolling = true;
+    cfg.layout.estimate_line_delay = line_delay_estimated;
+    cfg.line_delay_min_keyframes = 3;
+    cfg.host_blocks_from_adjoint = adjoint == 1;
+    cfg.twist_regularization = 0.0;
+    MarginalizationPrior prior(cfg.layout);
+    GlobalStates globals;
+    globals.state.line_delay_s = line_delay;
+    BundleAdjuster ba(cfg, w.camera, w.timing, *solver);
+    if (line_delay_estimated) ba.setGlobals(&globals);
+    ba.linearize(w.window, prior);
+    ba.fullSystem(&H[adjoint], &b[adjoint]);
+  }
+  ASSERT_EQ(H[0].rows(), H[1].rows());
+  ASSERT_GT(H[0].rows() - (3 * 14 + (line_delay_estimated ? 1 : 0)), 100);  // the points are in it
+  const Eigen::VectorXd rowmax = H[0].cwiseAbs().rowwise().maxCoeff();
+  int bad = 0;
+  for (Eigen::Index i = 0; i < H[0].rows(); ++i) {
+    for (Eigen::Index j = 0; j < H[0].cols(); ++j) {
+      const double tol = 1e-9 * std::max(rowmax[i], rowmax[j]) + 1e-12;
+      if (std::abs(H[0](i, j) - H[1](i, j)) > tol) ++bad;
+    }
+    if (std::abs(b[0][i] - b[1][i]) > 1e-9 * b[0].cwiseAbs().maxCoeff()) ++bad;
+  }
+  EXPECT_EQ(bad, 0);
+  EXPECT_GT(H[0].topLeftCorner(6, 6).norm(), 0.0);  // the host keyframe's pose block is not empty
+  if (line_delay_estimated) EXPECT_GT(H[0].row(3 * 14).head(6).norm(), 0.0);  // nor the delay's coupling to it
+}
+TEST(BundleAdjustmentGradient, RollingShutterSystemFromTheAdjointEqualsTheExplicitHostJacobians) {
+  checkRollingSystemFromAdjoint(false);
+}
+TEST(BundleAdjustmentGradient, EstimatedLineDelaySystemFromTheAdjointEqualsTheExplicitHostJacobians) {
+  checkRollingSystemFromAdjoint(true);
 }
 TEST(BundleAdjustmentGradient, RollingShutterMatchesNumericDifferences) { checkGradient(true); }
 TEST(BundleAdjustmentGradient, GlobalShutterSingleTargetEachBlockAtItsOwnScale) { checkGradient(false, true); }

@@ -312,6 +312,7 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["step_threshold"] = o.step_threshold;
   got["max_rejected_steps"] = o.max_rejected_steps;
   got["accept_all_steps"] = o.accept_all_steps;
+  got["host_blocks_from_adjoint"] = o.host_blocks_from_adjoint;
   got["min_step_rad"] = o.min_step_rad;
   got["min_step_idepth"] = o.min_step_idepth;
   got["marg_weight_factor"] = o.marg_weight_factor;

@@ -125,6 +125,33 @@ TEST_F(RsHostProjectionTest, JacobiansMatchNumeric) {
   }
 }
 
+// The identity the bundle adjustment's accumulation stands on (ba_linearize.cpp, accumulateChunkRolling):
+// the pixel depends on the central poses only through T_t^0 (T_h^0)^-1, so with left perturbations
+// d uv / d host pose = -(d uv / d target pose) Adj(T_t^0 (T_h^0)^-1), with readout, twists, angular
+// accelerations and either readout direction alike.
+TEST_F(RsHostProjectionTest, HostPoseJacobianIsMinusTheTargetsThroughThePairAdjoint) {
+  const Eigen::Matrix<double, 6, 6> A = (target_.T_c_w0 * host_.T_c_w0.inverse()).Adj();
+  int checked = 0;
+  for (bool acc : {false, true})
+    for (bool top_down : {true, false}) {
+      const RsFrame host = acc ? withWDot(host_, kHostWDot) : host_;
+      const RsFrame target = acc ? withWDot(target_, kTargetWDot) : target_;
+      const RowTiming tm = RowTiming::rolling(timing_.y0, 4e-5, top_down);
+      for (const Vec2& px : {Vec2(70.0, 200.0), Vec2(250.0, 30.0), Vec2(159.5, 127.5)})
+        for (double rho : {0.05, 0.5, 3.0}) {
+          Vec3 b;
+          double v_h;
+          hostPoint(px, b, v_h);
+          const RsHostProjection r = projectRollingShutter(*cam_, tm, host, target, b, v_h, rho, exact());
+          if (!r.valid) continue;
+          const Mat26 from_target = -r.d_uv_d_T0 * A;
+          EXPECT_JACOBIAN_NEAR_TOL(r.d_uv_d_Th0, from_target, 1e-9, 1e-9);
+          ++checked;
+        }
+    }
+  EXPECT_GE(checked, 30);
+}
+
 TEST_F(RsHostProjectionTest, NonPositiveInverseDepthIsInvalid) {
   Vec3 b;
   double v_h;

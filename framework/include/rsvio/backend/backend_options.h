@@ -26,6 +26,7 @@ struct BackendOptions {
   double step_threshold = 1e-4;       // stop when the relative energy decrease is below this
   int max_rejected_steps = 0;         // stop after this many rejected steps in a row (0: no such stop)
   bool accept_all_steps = false;      // take every step (DSO setting_forceAceptStep)
+  bool host_blocks_from_adjoint = true;  // rolling shutter: host-pose blocks from the target's (same energy)
   double min_step_rad = 0.0;          // stop after an accepted step whose pose steps are this small (DSO: 6e-5;
                                       // 0: no such stop) ...
   double min_step_idepth = 0.01;      // ... and whose RMS inverse-depth step is below this x their mean
