@@ -304,6 +304,28 @@ bool countObservation(ChunkSums& cs, const ObsLin& ol) {
   return true;
 }
 
+// One point's entries in the Schur arena (Linearization::blk_ids, hpc): its host block first, cleared
+// here, then one block per inlier observation's target, in observation order; done() stores the count.
+template <int KD>
+struct PointArena {
+  Linearization& L;
+  const int point, ab;
+  int nb = 1;
+  Eigen::Map<Eigen::Matrix<double, KD, 1>> host;
+  PointArena(Linearization& lin, int i, int host_index)
+      : L(lin), point(i), ab(lin.blk_begin[static_cast<size_t>(i)]),
+        host(lin.hpc.data() + static_cast<size_t>(ab) * KD) {
+    L.blk_ids[static_cast<size_t>(ab)] = host_index;
+    host.setZero();
+  }
+  // The next target's block (to be written whole).
+  Eigen::Map<Eigen::Matrix<double, KD, 1>> target(int target_index) {
+    L.blk_ids[static_cast<size_t>(ab + nb)] = target_index;
+    return Eigen::Map<Eigen::Matrix<double, KD, 1>>(L.hpc.data() + static_cast<size_t>(ab + nb++) * KD);
+  }
+  void done() { L.blk_count[static_cast<size_t>(point)] = nb; }
+};
+
 // Rolling shutter (global shutter: accumulateChunkGlobal below). Accumulates the points of one chunk:
 // their Schur data and the camera blocks. LD: the line delay is
 // estimated, one more geometric column (after the inverse depth) whose row goes to ChunkSums::Hl, Hll,
@@ -351,11 +373,7 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
     const ActivePoint& p = *m.points[static_cast<size_t>(i)];
     const int hb = p.host->index;
     double Hpp = 0.0, bp = 0.0, hpl = 0.0;
-    const int ab = L.blk_begin[static_cast<size_t>(i)];
-    int nb = 1;
-    L.blk_ids[static_cast<size_t>(ab)] = hb;
-    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_host(L.hpc.data() + static_cast<size_t>(ab) * KD);
-    h_host.setZero();
+    PointArena<KD> arena(L, i, hb);
     for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
       const ObsLin& ol = L.obs[static_cast<size_t>(r)];
       if (!countObservation(cs, ol)) continue;
@@ -421,16 +439,13 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
         cs.bl += bg[NG0];
         hpl += Hgg(ID, NG0);
       }
-      h_host += Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol);
-      L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
-      Eigen::Map<Eigen::Matrix<double, KD, 1>>(L.hpc.data() + static_cast<size_t>(ab + nb) * KD) =
-          Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol + KD);
-      ++nb;
+      arena.host += Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol);
+      arena.target(tb) = Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol + KD);
     }
     L.Hpp[static_cast<size_t>(i)] = Hpp;
     L.bp[static_cast<size_t>(i)] = bp;
     L.hpl[static_cast<size_t>(i)] = hpl;
-    L.blk_count[static_cast<size_t>(i)] = nb;
+    arena.done();
   }
 }
 
@@ -474,11 +489,7 @@ void accumulateChunkRolling(BundleAdjuster::Impl& m, Linearization& L, int chunk
     const ActivePoint& p = *m.points[static_cast<size_t>(i)];
     const int hb = p.host->index;
     double Hpp = 0.0, bp = 0.0, hpl = 0.0;
-    const int ab = L.blk_begin[static_cast<size_t>(i)];
-    int nb = 1;
-    L.blk_ids[static_cast<size_t>(ab)] = hb;
-    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_host(L.hpc.data() + static_cast<size_t>(ab) * KD);
-    h_host.setZero();
+    PointArena<KD> arena(L, i, hb);
     for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
       const ObsLin& ol = L.obs[static_cast<size_t>(r)];
       if (!countObservation(cs, ol)) continue;
@@ -522,20 +533,18 @@ void accumulateChunkRolling(BundleAdjuster::Impl& m, Linearization& L, int chunk
       for (int k = 0; k < ID; ++k) hc[k] = Hgg(k, ID);
       const Eigen::Vector4d ha = Hga.row(ID).transpose();
       const Mat6& A = L.pair_adj[pi];
-      h_host.segment<6>(StateLayout::kPose).noalias() -= A.transpose() * hc.head<6>();
-      h_host.segment<6>(StateLayout::kTwist) += hc.segment<6>(6);
-      h_host.segment<2>(StateLayout::kAffine) += ha.head<2>();
-      L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
-      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t(L.hpc.data() + static_cast<size_t>(ab + nb) * KD);
+      arena.host.segment<6>(StateLayout::kPose).noalias() -= A.transpose() * hc.head<6>();
+      arena.host.segment<6>(StateLayout::kTwist) += hc.segment<6>(6);
+      arena.host.segment<2>(StateLayout::kAffine) += ha.head<2>();
+      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t = arena.target(tb);
       h_t.segment<6>(StateLayout::kPose) = hc.head<6>();
       h_t.segment<6>(StateLayout::kTwist) = hc.segment<6>(12);
       h_t.segment<2>(StateLayout::kAffine) = ha.tail<2>();
-      ++nb;
     }
     L.Hpp[static_cast<size_t>(i)] = Hpp;
     L.bp[static_cast<size_t>(i)] = bp;
     L.hpl[static_cast<size_t>(i)] = hpl;
-    L.blk_count[static_cast<size_t>(i)] = nb;
+    arena.done();
   }
 }
 
@@ -632,11 +641,7 @@ void accumulateChunkGlobal(BundleAdjuster::Impl& m, Linearization& L, int chunk)
     const ActivePoint& p = *m.points[static_cast<size_t>(i)];
     const int hb = p.host->index;
     double Hpp = 0.0, bp = 0.0;
-    const int ab = L.blk_begin[static_cast<size_t>(i)];
-    int nb = 1;
-    L.blk_ids[static_cast<size_t>(ab)] = hb;
-    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_host(L.hpc.data() + static_cast<size_t>(ab) * KD);
-    h_host.setZero();
+    PointArena<KD> arena(L, i, hb);
     for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
       const ObsLin& ol = L.obs[static_cast<size_t>(r)];
       if (!countObservation(cs, ol)) continue;
@@ -670,18 +675,16 @@ void accumulateChunkGlobal(BundleAdjuster::Impl& m, Linearization& L, int chunk)
       // The point's coupling to its host block (pose through the adjoint, affine (a_h, b_h)) and to the
       // target block (pose, affine (a_t, b_t)).
       const Eigen::Matrix<double, 6, 6>& A = L.pair_adj[pi];
-      h_host.head<6>().noalias() -= A.transpose() * Hgg.col(6).head<6>();
-      h_host.tail<2>() += Hga.row(6).head<2>().transpose();
-      L.blk_ids[static_cast<size_t>(ab + nb)] = tb;
-      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t(L.hpc.data() + static_cast<size_t>(ab + nb) * KD);
+      arena.host.head<6>().noalias() -= A.transpose() * Hgg.col(6).head<6>();
+      arena.host.tail<2>() += Hga.row(6).head<2>().transpose();
+      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t = arena.target(tb);
       h_t.head<6>() = Hgg.col(6).head<6>();
       h_t.tail<2>() = Hga.row(6).tail<2>().transpose();
-      ++nb;
     }
     L.Hpp[static_cast<size_t>(i)] = Hpp;
     L.bp[static_cast<size_t>(i)] = bp;
     L.hpl[static_cast<size_t>(i)] = 0.0;
-    L.blk_count[static_cast<size_t>(i)] = nb;
+    arena.done();
   }
   if constexpr (PO) return;
   // The pairs' sums into the chunk's camera blocks (state order per block: pose 0-5, affine 6-7).
