@@ -49,6 +49,35 @@ int blockType(int i) {
   return i < 11 ? 4 : 5;                    // twist translation, twist rotation
 }
 
+// Away from the optimum, so the gradient is not ~0: keyframes 1 and 2 moved, their brightness off,
+// the inverse depths 2 % off, and with twists (rolling shutter) every twist moved.
+void perturbWindow(test::TestWindow& w, bool twists) {
+  w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
+  w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
+  w.window[1]->state.affine.a = 0.05;
+  w.window[2]->state.affine.b = 3.0;
+  if (twists)
+    for (auto& kf : w.window) kf->state.twist += test::tw(0.2, -0.2, 0.1, 0.1, 0.1, -0.1);
+  for (auto& kf : w.window)
+    for (ActivePoint& p : kf->points) p.idepth *= 1.02;
+}
+
+// Entries of two full systems (H, b) that differ by more than 1e-9 of their row's or column's scale;
+// map(i): the index in the second of the first's i.
+template <class Map>
+int entriesApart(const Eigen::MatrixXd H[2], const Eigen::VectorXd b[2], Map map) {
+  const Eigen::VectorXd rowmax = H[0].cwiseAbs().rowwise().maxCoeff();
+  int bad = 0;
+  for (Eigen::Index i = 0; i < H[0].rows(); ++i) {
+    for (Eigen::Index j = 0; j < H[0].cols(); ++j) {
+      const double tol = 1e-9 * std::max(rowmax[i], rowmax[j]) + 1e-12;
+      if (std::abs(H[0](i, j) - H[1](map(i), map(j))) > tol) ++bad;
+    }
+    if (std::abs(b[0][i] - b[1][map(i)]) > 1e-9 * b[0].cwiseAbs().maxCoeff()) ++bad;
+  }
+  return bad;
+}
+
 // single_target: every point is observed in the next keyframe only, so no keyframe's gradient is a
 // small difference of large per-target terms and each block can be held to its own keyframe's scale
 // (with targets on both sides a host's gradient nearly cancels: measured host rotation -1.5e5
@@ -82,15 +111,7 @@ void checkGradient(bool rolling, bool single_target = false, bool line_delay_est
   GlobalStates globals;  // the estimated line delay, at the images' own (the other states are off)
   globals.state.line_delay_s = line_delay;
   if (line_delay_estimated) ba.setGlobals(&globals);
-  // Away from the optimum, so the gradient is not ~0.
-  w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
-  w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
-  w.window[1]->state.affine.a = 0.05;
-  w.window[2]->state.affine.b = 3.0;
-  if (rolling)
-    for (auto& kf : w.window) kf->state.twist += test::tw(0.2, -0.2, 0.1, 0.1, 0.1, -0.1);
-  for (auto& kf : w.window)
-    for (ActivePoint& p : kf->points) p.idepth *= 1.02;
+  perturbWindow(w, rolling);
   ba.linearize(w.window, prior);
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
@@ -192,12 +213,7 @@ TEST(BundleAdjustmentGradient, GlobalShutterSystemEqualsTheRollingPathWithoutRea
   test::TestWindow w(3, false);
   w.addPoints(0, 150);
   w.addPoints(1, 100, 5);
-  w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
-  w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
-  w.window[1]->state.affine.a = 0.05;
-  w.window[2]->state.affine.b = 3.0;
-  for (auto& kf : w.window)
-    for (ActivePoint& p : kf->points) p.idepth *= 1.02;
+  perturbWindow(w, false);
   auto solver = test::makePlugin<SolverBackend>("solver.dense");
   MarginalizationPrior prior_gs(StateLayout{}), prior_rs([] {
     StateLayout l;
@@ -222,17 +238,7 @@ TEST(BundleAdjustmentGradient, GlobalShutterSystemEqualsTheRollingPathWithoutRea
   ASSERT_EQ(H[1].rows() - ncr, np);
   ASSERT_GT(np, 100);
   auto map = [&](Eigen::Index i) { return i < ncg ? (i / 8) * 14 + i % 8 : i - ncg + ncr; };
-  // Each entry against the largest of its row and column (a block's own scale), to 1e-9.
-  const Eigen::VectorXd rowmax = H[0].cwiseAbs().rowwise().maxCoeff();
-  int bad = 0;
-  for (Eigen::Index i = 0; i < H[0].rows(); ++i) {
-    for (Eigen::Index j = 0; j < H[0].cols(); ++j) {
-      const double tol = 1e-9 * std::max(rowmax[i], rowmax[j]) + 1e-12;
-      if (std::abs(H[0](i, j) - H[1](map(i), map(j))) > tol) ++bad;
-    }
-    if (std::abs(b[0][i] - b[1][map(i)]) > 1e-9 * b[0].cwiseAbs().maxCoeff()) ++bad;
-  }
-  EXPECT_EQ(bad, 0);
+  EXPECT_EQ(entriesApart(H, b, map), 0);  // each entry against its row's and column's scale
   EXPECT_GT(H[0].topLeftCorner(8, 8).norm(), 0.0);  // the host keyframe's block is not empty
 }
 // The rolling-shutter accumulation forms the host pose's blocks from the target pose's through the
@@ -246,13 +252,7 @@ void checkRollingSystemFromAdjoint(bool line_delay_estimated) {
   test::TestWindow w(3, true, line_delay, 1.0, 0.05);
   w.addPoints(0, 150);
   w.addPoints(1, 100, 5);
-  w.window[1]->state.T_c_w = SE3d::exp(test::tw(0.004, -0.002, 0.003, 0.002, -0.001, 0.001)) * w.window[1]->state.T_c_w;
-  w.window[2]->state.T_c_w = SE3d::exp(test::tw(-0.003, 0.002, -0.002, -0.001, 0.002, 0.001)) * w.window[2]->state.T_c_w;
-  w.window[1]->state.affine.a = 0.05;
-  w.window[2]->state.affine.b = 3.0;
-  for (auto& kf : w.window) kf->state.twist += test::tw(0.2, -0.2, 0.1, 0.1, 0.1, -0.1);
-  for (auto& kf : w.window)
-    for (ActivePoint& p : kf->points) p.idepth *= 1.02;
+  perturbWindow(w, true);
   auto solver = test::makePlugin<SolverBackend>("solver.dense");
   Eigen::MatrixXd H[2];
   Eigen::VectorXd b[2];
@@ -273,16 +273,7 @@ void checkRollingSystemFromAdjoint(bool line_delay_estimated) {
   }
   ASSERT_EQ(H[0].rows(), H[1].rows());
   ASSERT_GT(H[0].rows() - (3 * 14 + (line_delay_estimated ? 1 : 0)), 100);  // the points are in it
-  const Eigen::VectorXd rowmax = H[0].cwiseAbs().rowwise().maxCoeff();
-  int bad = 0;
-  for (Eigen::Index i = 0; i < H[0].rows(); ++i) {
-    for (Eigen::Index j = 0; j < H[0].cols(); ++j) {
-      const double tol = 1e-9 * std::max(rowmax[i], rowmax[j]) + 1e-12;
-      if (std::abs(H[0](i, j) - H[1](i, j)) > tol) ++bad;
-    }
-    if (std::abs(b[0][i] - b[1][i]) > 1e-9 * b[0].cwiseAbs().maxCoeff()) ++bad;
-  }
-  EXPECT_EQ(bad, 0);
+  EXPECT_EQ(entriesApart(H, b, [](Eigen::Index i) { return i; }), 0);
   EXPECT_GT(H[0].topLeftCorner(6, 6).norm(), 0.0);  // the host keyframe's pose block is not empty
   if (line_delay_estimated) EXPECT_GT(H[0].row(3 * 14).head(6).norm(), 0.0);  // nor the delay's coupling to it
 }
