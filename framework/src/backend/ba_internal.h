@@ -1,4 +1,4 @@
-// Private state of BundleAdjuster shared by ba_linearize.cpp and ba_solve.cpp.
+// Private state of BundleAdjuster shared by ba_linearize.cpp, ba_accumulate.cpp and ba_solve.cpp.
 #pragma once
 #include <Eigen/Core>
 #include <memory>
@@ -61,7 +61,7 @@ struct Linearization {
   std::vector<double> hpc;              // kfDim values per arena entry: d^2 E / d rho d x_block
   // Per pair (h * nk + t), Adj(T_t T_h^-1) of the evaluated (central) poses, with which
   // d uv / d host pose = -d uv / d target pose * Adj (left perturbations of T_c_w, lie.h), for a
-  // global and a rolling shutter alike (ba_linearize.cpp, accumulateChunkGlobal and
+  // global and a rolling shutter alike (ba_accumulate.cpp, accumulateChunkGlobal and
   // accumulateChunkRolling).
   std::vector<Eigen::Matrix<double, 6, 6>> pair_adj;
   Eigen::MatrixXd Hcc;                  // cameras: photometric + priors + terms, undamped, unmasked
@@ -126,4 +126,30 @@ struct BundleAdjuster::Impl {
   GlobalStates* globals = nullptr;      // visual-inertial: updated with the keyframes
 };
 
+namespace ba {
+
+// The linearisation's steps (ba_linearize.cpp, ba_accumulate.cpp), called by the solver (ba_solve.cpp).
+void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleAdjustmentConfig& cfg,
+                    const std::vector<ActivePoint*>* only);
+// points_only: each point's H_pp, b_p, the observations and the energies, no camera blocks (L.Hcc,
+// L.bc, L.hpc are left as they were: optimizeDepths reads none of them).
+void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                          const CameraModel& camera, const RowTiming& timing, bool points_only = false);
+void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                    const std::vector<const WindowTerm*>& terms);
+// linearizePhotometric in two halves: the residuals, weights and Jacobians of every observation
+// (evaluatePhotometric), then the per-point and camera blocks from them (accumulatePhotometric).
+void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                         const CameraModel& camera, const RowTiming& timing);
+void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
+                           bool points_only);
+// The energies alone, bit-identical to L.energy_photo and L.energy_other of the full linearisation: a
+// trial step is judged on them, and only an accepted one is accumulated.
+double photometricEnergy(const BundleAdjuster::Impl& m, const Linearization& L);
+double cameraTermsEnergy(BundleAdjuster::Impl& m, const BundleAdjustmentConfig& cfg,
+                         const std::vector<const WindowTerm*>& terms);
+double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
+                      Eigen::Ref<Eigen::VectorXd> b);
+
+}  // namespace ba
 }  // namespace rsvio

@@ -11,27 +11,6 @@
 
 namespace rsvio {
 namespace ba {
-void buildStructure(BundleAdjuster::Impl& m, KeyframeList& window, const BundleAdjustmentConfig& cfg,
-                    const std::vector<ActivePoint*>* only);
-// points_only: each point's H_pp, b_p, the observations and the energies, no camera blocks (L.Hcc,
-// L.bc, L.hpc are left as they were: optimizeDepths reads none of them).
-void linearizePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                          const CameraModel& camera, const RowTiming& timing, bool points_only = false);
-void addCameraTerms(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                    const std::vector<const WindowTerm*>& terms);
-// linearizePhotometric in two halves: the residuals, weights and Jacobians of every observation
-// (evaluatePhotometric), then the per-point and camera blocks from them (accumulatePhotometric).
-void evaluatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                         const CameraModel& camera, const RowTiming& timing);
-void accumulatePhotometric(BundleAdjuster::Impl& m, Linearization& L, const BundleAdjustmentConfig& cfg,
-                           bool points_only);
-// The energies alone, bit-identical to L.energy_photo and L.energy_other of the full linearisation: a
-// trial step is judged on them, and only an accepted one is accumulated.
-double photometricEnergy(const BundleAdjuster::Impl& m, const Linearization& L);
-double cameraTermsEnergy(BundleAdjuster::Impl& m, const BundleAdjustmentConfig& cfg,
-                         const std::vector<const WindowTerm*>& terms);
-double keyframePriors(const Keyframe& kf, const BundleAdjustmentConfig& cfg, Eigen::Ref<Eigen::MatrixXd> H,
-                      Eigen::Ref<Eigen::VectorXd> b);
 
 namespace {
 

@@ -204,7 +204,7 @@ void checkGradient(bool rolling, bool single_target = false, bool line_delay_est
 TEST(BundleAdjustmentGradient, GlobalShutterMatchesNumericDifferences) { checkGradient(false); }
 
 // The global-shutter accumulation forms a host's blocks from its targets' through the pair's adjoint
-// (ba_linearize.cpp, accumulateChunkGlobal); the rolling-shutter accumulation forms every block from
+// (ba_accumulate.cpp, accumulateChunkGlobal); the rolling-shutter accumulation forms every block from
 // the general projection's own host Jacobians (host_blocks_from_adjoint off). With no readout (line delay 0, zero twists) both describe
 // the same energy, so every entry of the full system (cameras, camera-point couplings, points) must
 // agree to rounding. The gradient test above sees b only; this sees H. Shown once: the host-target
@@ -242,7 +242,7 @@ TEST(BundleAdjustmentGradient, GlobalShutterSystemEqualsTheRollingPathWithoutRea
   EXPECT_GT(H[0].topLeftCorner(8, 8).norm(), 0.0);  // the host keyframe's block is not empty
 }
 // The rolling-shutter accumulation forms the host pose's blocks from the target pose's through the
-// pair's adjoint too (ba_linearize.cpp, accumulateChunkRolling): with readout, non-zero twists and the
+// pair's adjoint too (ba_accumulate.cpp, accumulateChunkRolling): with readout, non-zero twists and the
 // line delay fixed or estimated, its full system (cameras, the line delay's row, camera-point
 // couplings, points) equals that of the explicit host-pose Jacobians (accumulateChunk) to rounding.
 // Shown once: the host's rows formed with A instead of A^T (H_h,y = -A S_t,y) fail 864 and 888

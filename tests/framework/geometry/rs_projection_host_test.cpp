@@ -125,7 +125,7 @@ TEST_F(RsHostProjectionTest, JacobiansMatchNumeric) {
   }
 }
 
-// The identity the bundle adjustment's accumulation stands on (ba_linearize.cpp, accumulateChunkRolling):
+// The identity the bundle adjustment's accumulation stands on (ba_accumulate.cpp, accumulateChunkRolling):
 // the pixel depends on the central poses only through T_t^0 (T_h^0)^-1, so with left perturbations
 // d uv / d host pose = -(d uv / d target pose) Adj(T_t^0 (T_h^0)^-1), with readout, twists, angular
 // accelerations and either readout direction alike.

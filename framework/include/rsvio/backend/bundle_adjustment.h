@@ -100,7 +100,7 @@ struct BundleAdjustmentConfig {
   int threads = 1;                 // 1 or 2
   // Rolling shutter: false forms every observation's host-pose Jacobian and accumulates it (the
   // reference the tests check the default against; slower). true (default): the host pose's blocks
-  // from the target pose's through the pair's adjoint, as for a global shutter (ba_linearize.cpp,
+  // from the target pose's through the pair's adjoint, as for a global shutter (ba_accumulate.cpp,
   // accumulateChunkRolling; docs/rolling_shutter.md "Cost").
   bool host_blocks_from_adjoint = true;
 };
