@@ -58,6 +58,11 @@ ParamTable backendParamTable() {
                   "new keyframe when the tracking RMSE exceeds this times the first one after the last keyframe"),
       paramDouble("kf_max_interval_s", d.kf_max_interval_s, 0.0, 1e6, "s",
                   "a new keyframe at least this often (0: off)"),
+      paramDouble("kf_flow_scale", d.kf_flow_scale, 0.0, 1e6, "",
+                  "both flow weights (kf_weight_t, kf_weight_rt) times this once the run has kf_start_keyframes "
+                  "keyframes (DSO's setting_kfGlobalWeight; < 1: fewer keyframes)"),
+      paramInt("kf_start_keyframes", d.kf_start_keyframes, 0, 1000000, "",
+               "the run's first keyframes, made with the flow weights unscaled (the start's depths need them close)"),
       paramDouble("min_points_remaining", d.min_points_remaining, 0.0, 1.0, "",
                   "marginalise a keyframe when fewer than this share of its points remain (DSO: 0.05)"),
       paramDouble("max_log_affine", d.max_log_affine, 0.0, 100.0, "",
@@ -125,6 +130,8 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.kf_weight_affine = p.getDouble("kf_weight_affine");
   o.kf_rmse_factor = p.getDouble("kf_rmse_factor");
   o.kf_max_interval_s = p.getDouble("kf_max_interval_s");
+  o.kf_flow_scale = p.getDouble("kf_flow_scale");
+  o.kf_start_keyframes = p.getInt("kf_start_keyframes");
   o.min_points_remaining = p.getDouble("min_points_remaining");
   o.max_log_affine = p.getDouble("max_log_affine");
   o.activation_iterations = static_cast<int>(p.getInt("activation_iterations"));

@@ -11,7 +11,8 @@ bool needKeyframe(const BackendOptions& o, const KeyframeCue& c, std::string* re
     return true;
   };
   const double wh = std::max(1, c.width + c.height);
-  const double score = (o.kf_weight_t * c.flow_t_px + o.kf_weight_rt * c.flow_rt_px) / wh;
+  const double scale = c.keyframes >= o.kf_start_keyframes ? o.kf_flow_scale : 1.0;
+  const double score = scale * (o.kf_weight_t * c.flow_t_px + o.kf_weight_rt * c.flow_rt_px) / wh;
   if (score + o.kf_weight_affine * std::abs(c.log_brightness_ratio) > 1.0) {
     if (score > 1.0) return say("flow");
     return say(score > 0.0 ? "flow and brightness" : "brightness");

@@ -255,6 +255,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   cue.rmse = r.rmse;
   cue.first_rmse = tracking->firstRmse();
   cue.seconds_since_keyframe = nsToS(frame.t_ns - ref.t_ns);
+  cue.keyframes = ref.kf_id + 1;  // the reference is the newest keyframe; kf_id counts from 0
   cue.width = camera->width();
   cue.height = camera->height();
   std::string why;

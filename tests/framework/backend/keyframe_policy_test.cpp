@@ -129,6 +129,44 @@ TEST(KeyframePolicy, KeyframeRateOnASteadyMotion) {
   EXPECT_EQ(keyframes, 25);
 }
 
+// The flow weights scaled (kf_flow_scale, DSO's setting_kfGlobalWeight) once the run has
+// kf_start_keyframes keyframes: on the steady motion above a keyframe every 4 frames with DSO's
+// weights; with the scale 0.5, every 8 (0.5 (44.8 * 4 k + 22.4 * 6 k) / 1152 > 1 at k = 8): 12 over
+// 100 frames; with the run's first 7 keyframes unscaled (the first came before frame 0), 6 more every 4
+// frames, then every 8: 6 + 9 = 15. Fails when
+// the scale is ignored (25), applied from the start (12) or only before the start keyframes.
+TEST(KeyframePolicy, FlowScaleAppliesOnceTheRunHasItsStartKeyframes) {
+  BackendOptions o;
+  EXPECT_EQ(o.kf_flow_scale, 1.0);  // DSO: 1
+  EXPECT_EQ(o.kf_start_keyframes, 0);
+  auto count = [](const BackendOptions& opt) {
+    int keyframes = 0, since = 0;
+    for (int f = 0; f < 100; ++f) {
+      ++since;
+      KeyframeCue c = cue(4.0 * since, 6.0 * since, 0.0, 5.0, 5.0, 0.05 * since);
+      c.keyframes = 1 + keyframes;  // the run's first keyframe came before frame 0
+      if (needKeyframe(opt, c)) {
+        ++keyframes;
+        since = 0;
+      }
+    }
+    return keyframes;
+  };
+  EXPECT_EQ(count(o), 25);
+  o.kf_flow_scale = 0.5;
+  EXPECT_EQ(count(o), 12);
+  o.kf_start_keyframes = 7;
+  EXPECT_EQ(count(o), 15);
+  // One cue on either side of the start: 1.5x the translation threshold alone.
+  KeyframeCue c = cue(1.5 * (640 + 512) / o.kf_weight_t, 0.0);
+  c.keyframes = 6;
+  std::string why;
+  EXPECT_TRUE(needKeyframe(o, c, &why));
+  EXPECT_EQ(why, "flow");
+  c.keyframes = 7;
+  EXPECT_FALSE(needKeyframe(o, c));
+}
+
 // ---- keyframesToMarginalize
 
 struct Window {
@@ -325,6 +363,8 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["kf_weight_affine"] = o.kf_weight_affine;
   got["kf_rmse_factor"] = o.kf_rmse_factor;
   got["kf_max_interval_s"] = o.kf_max_interval_s;
+  got["kf_flow_scale"] = o.kf_flow_scale;
+  got["kf_start_keyframes"] = o.kf_start_keyframes;
   got["min_points_remaining"] = o.min_points_remaining;
   got["max_log_affine"] = o.max_log_affine;
   got["activation_iterations"] = o.activation_iterations;

@@ -42,6 +42,8 @@ struct BackendOptions {
   double kf_weight_affine = 2.0;             // |log exposure ratio|
   double kf_rmse_factor = 2.0;               // new KF when rmse > factor x the first rmse after the last KF
   double kf_max_interval_s = 0.0;            // new KF at least this often (0 = off, DSO's default)
+  double kf_flow_scale = 1.0;                // both flow weights times this (DSO's setting_kfGlobalWeight) ...
+  int kf_start_keyframes = 0;                // ... once the run has this many keyframes (before: times 1)
   // Marginalisation of keyframes.
   double min_points_remaining = 0.05;  // DSO setting_minPointsRemaining
   double max_log_affine = 0.7;         // DSO setting_maxLogAffFacInWindow

@@ -3,7 +3,10 @@
 //
 // Contract
 // - needKeyframe(): a new keyframe when
-//     (kf_weight_t * flow_t + kf_weight_rt * flow_rt) / (width + height) + kf_weight_affine |log a| > 1
+//     s (kf_weight_t * flow_t + kf_weight_rt * flow_rt) / (width + height) + kf_weight_affine |log a| > 1
+//   with s = kf_flow_scale once the run has kf_start_keyframes keyframes and s = 1 before (DSO's
+//   setting_kfGlobalWeight, s = 1, throughout; gs_vo.json's s = 0.5 after 7 keyframes: docs/performance.md,
+//   "Fewer keyframes")
 //   (flow_t, flow_rt: RMS pixel shift of the reference points with the translation only / the full
 //   relative motion, FrameTracker's indicators; a: the brightness ratio to the reference keyframe),
 //   or when the tracking RMSE exceeds kf_rmse_factor x the first RMSE after the reference keyframe
@@ -31,6 +34,7 @@ struct KeyframeCue {
   double rmse = 0.0;
   double first_rmse = 0.0;            // RMSE of the first frame tracked against the reference (NaN: none)
   double seconds_since_keyframe = 0.0;
+  int64_t keyframes = 0;              // keyframes the run has made so far
   int width = 0, height = 0;
 };
 
