@@ -131,7 +131,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.kf_rmse_factor = p.getDouble("kf_rmse_factor");
   o.kf_max_interval_s = p.getDouble("kf_max_interval_s");
   o.kf_flow_scale = p.getDouble("kf_flow_scale");
-  o.kf_start_keyframes = p.getInt("kf_start_keyframes");
+  o.kf_start_keyframes = static_cast<int>(p.getInt("kf_start_keyframes"));
   o.min_points_remaining = p.getDouble("min_points_remaining");
   o.max_log_affine = p.getDouble("max_log_affine");
   o.activation_iterations = static_cast<int>(p.getInt("activation_iterations"));

@@ -133,8 +133,8 @@ TEST(KeyframePolicy, KeyframeRateOnASteadyMotion) {
 // kf_start_keyframes keyframes: on the steady motion above a keyframe every 4 frames with DSO's
 // weights; with the scale 0.5, every 8 (0.5 (44.8 * 4 k + 22.4 * 6 k) / 1152 > 1 at k = 8): 12 over
 // 100 frames; with the run's first 7 keyframes unscaled (the first came before frame 0), 6 more every 4
-// frames, then every 8: 6 + 9 = 15. Fails when
-// the scale is ignored (25), applied from the start (12) or only before the start keyframes.
+// frames, then every 8: 6 + 9 = 15. Fails when the scale is ignored (25) or applied from the start (12;
+// shown once).
 TEST(KeyframePolicy, FlowScaleAppliesOnceTheRunHasItsStartKeyframes) {
   BackendOptions o;
   EXPECT_EQ(o.kf_flow_scale, 1.0);  // DSO: 1

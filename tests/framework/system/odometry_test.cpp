@@ -43,7 +43,8 @@ TEST(Odometry, TinyGlobalShutterSequenceIsTrackedWithSmallError) {
 // (320x256, 3 s, ~30 ms readout) tracks every frame after its start, far better than the
 // global-shutter model on the same images. Measured 2026-12-06: rs_vo 9.9 mm ATE over 2.6 m of path
 // at estimator seed 2 (12.1 mm since gs_vo.json makes half DSO's keyframes after its first 7; with half
-// from the first frame rs_vo was lost at frame 9 on every seed 0-5); gs_vo is lost at frame 16. The rs_vo run is chaotic at this size: over
+// from the first frame rs_vo was lost at frame 9 on every seed 0-5); gs_vo is lost at frame 16.
+// The rs_vo run is chaotic at this size: over
 // estimator seeds 0-5 it ends at 9-66 mm and is lost at frame 16 on two of them (seeds 1 and 4), with
 // either accumulation of the host blocks (backend.host_blocks_from_adjoint false: 14-28 mm, the same
 // two lost); seed 0, which this test ran before, ended at 25.0 and then 27.3 mm against its bound of
