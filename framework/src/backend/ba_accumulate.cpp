@@ -56,6 +56,56 @@ struct PointArena {
   void done() { L.blk_count[static_cast<size_t>(point)] = nb; }
 };
 
+// A point's own Schur sums: H_pp, b_p and its line-delay coupling h_pl (zero unless estimated).
+struct PointSums {
+  double Hpp = 0.0, bp = 0.0, hpl = 0.0;
+};
+
+// The chunk's points [begin, end), each with its arena and sums: visit(ol, hb, tb, arena, sums) for each
+// observation that counts as an inlier (host block hb, target block tb), then the sums are stored and
+// the arena closed. All three accumulations below walk the points this way.
+template <int KD, class Visit>
+void forEachInlier(const BundleAdjuster::Impl& m, Linearization& L, ChunkSums& cs, int begin, int end,
+                   Visit&& visit) {
+  for (int i = begin; i < end; ++i) {
+    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
+    const int hb = p.host->index;
+    PointSums sums;
+    PointArena<KD> arena(L, i, hb);
+    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
+      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
+      if (!countObservation(cs, ol)) continue;
+      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
+      visit(ol, hb, tb, arena, sums);
+    }
+    L.Hpp[static_cast<size_t>(i)] = sums.Hpp;
+    L.bp[static_cast<size_t>(i)] = sums.bp;
+    L.hpl[static_cast<size_t>(i)] = sums.hpl;
+    arena.done();
+  }
+}
+
+// One observation's compact products over its NG geometric columns G (2 x NG, gathered by the caller;
+// the four affine columns are selectors and need no products): MG = M_uu G (form), then the upper
+// triangle (a <= c) of H_gg = G^T M_uu G, H_ga = G^T M_ua and b_g = -G^T g_uv (formUpper).
+template <int NG>
+struct CompactProducts {
+  Eigen::Matrix<double, 2, NG> G, MG;
+  Eigen::Matrix<double, NG, NG> Hgg;
+  Eigen::Matrix<double, NG, 4> Hga;
+  Eigen::Matrix<double, NG, 1> bg;
+  void form(const ObsLin& ol) { MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G); }
+  void formGradient(const ObsLin& ol) { bg.noalias() = -G.transpose() * ol.g.template head<2>(); }
+  void formUpper(const ObsLin& ol) {
+    for (int a = 0; a < NG; ++a) {
+      const double g0 = G(0, a), g1 = G(1, a);
+      for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
+    }
+    Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
+    formGradient(ol);
+  }
+};
+
 // Rolling shutter (global shutter: accumulateChunkGlobal below). Accumulates the points of one chunk:
 // their Schur data and the camera blocks. LD: the line delay is
 // estimated, one more geometric column (after the inverse depth) whose row goes to ChunkSums::Hl, Hll,
@@ -73,7 +123,6 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   constexpr int N = 2 * KD + 1;
   constexpr int NG0 = 25;  // poses, twists, inverse depth (index NG0 - 1)
   constexpr int NG = NG0 + (LD ? 1 : 0);  // and the line delay (index NG0)
-  using GM = Eigen::Matrix<double, 2, NG>;
   ChunkSums& cs = m.chunks[static_cast<size_t>(chunk)];
   if constexpr (!PO) {
     cs.H.setZero();
@@ -94,89 +143,72 @@ void accumulateChunk(BundleAdjuster::Impl& m, Linearization& L, int chunk) {
   constexpr int ID = NG0 - 1;  // the inverse depth's compact column
   const int aidx[4] = {StateLayout::kAffine, StateLayout::kAffine + 1, KD + StateLayout::kAffine,
                        KD + StateLayout::kAffine + 1};
-  GM G;
-  Eigen::Matrix<double, 2, NG> MG;
-  Eigen::Matrix<double, NG, NG> Hgg;
-  Eigen::Matrix<double, NG, 4> Hga;
-  Eigen::Matrix<double, NG, 1> bg;
-  for (int i = begin; i < end; ++i) {
-    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
-    const int hb = p.host->index;
-    double Hpp = 0.0, bp = 0.0, hpl = 0.0;
-    PointArena<KD> arena(L, i, hb);
-    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
-      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
-      if (!countObservation(cs, ol)) continue;
-      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
-      for (int k = 0; k < NG0; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
-      if constexpr (LD) G.col(NG0) = ol.Jl;
-      MG.noalias() = ol.M.template topLeftCorner<2, 2>().lazyProduct(G);
-      if constexpr (PO) {
-        // The inverse depth's entries alone, as the triangle below forms them.
-        Hpp += G(0, ID) * MG(0, ID) + G(1, ID) * MG(1, ID);
-        bg.noalias() = -G.transpose() * ol.g.template head<2>();
-        bp += bg[ID];
-        continue;
-      }
-      // Upper triangle only (a <= c): all the scatter below reads.
-      for (int a = 0; a < NG; ++a) {
-        const double g0 = G(0, a), g1 = G(1, a);
-        for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
-      }
-      Hga.noalias() = G.transpose().lazyProduct(ol.M.template topRightCorner<2, 4>());
-      bg.noalias() = -G.transpose() * ol.g.template head<2>();
-      // Straight into the chunk's blocks: each entry of the host/target blocks receives the same one
-      // addition per observation as through an N x N staging matrix (bit-identical), without writing
-      // and re-reading that matrix. Local index x < KD is the host block, KD <= x < 2 KD the target's,
-      // 2 KD the inverse depth (kept per point for the Schur complement).
-      int row[N];
-      for (int x = 0; x < KD; ++x) row[x] = hb * KD + x, row[KD + x] = tb * KD + x;
-      double* Hd = cs.H.data();
-      const Eigen::Index ld = cs.H.rows();
-      double hcol[N];  // column 2 KD of the local Hessian: d^2 E / d rho d x
-      // Only the upper triangles of Hgg and of cs.H are formed, and linearizePhotometric mirrors cs.H's
-      // to the lower triangle once: half the products and scattered additions of the full form (the
-      // largest cost of a rolling-shutter linearisation, profiled in docs/rolling_shutter.md, "Cost").
-      for (int a = 0; a < ID; ++a) {
-        const int ga = gidx[a];
-        const int ra = row[ga];
-        for (int c = a; c < ID; ++c) {
-          const int rc = row[gidx[c]];
-          Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hgg(a, c);
-        }
-        for (int c = 0; c < 4; ++c) {
-          const int rc = row[aidx[c]];
-          Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hga(a, c);
-        }
-        hcol[ga] = Hgg(a, ID);
-        cs.b[ra] += bg[a];
-        if constexpr (LD) cs.Hl[ra] += Hgg(a, NG0);
-      }
-      for (int a = 0; a < 4; ++a) {
-        const int ra = row[aidx[a]];
-        for (int c = 0; c < 4; ++c) {
-          const int rc = row[aidx[c]];
-          if (ra <= rc) Hd[static_cast<Eigen::Index>(rc) * ld + ra] += ol.M(2 + a, 2 + c);
-        }
-        hcol[aidx[a]] = Hga(ID, a);
-        cs.b[ra] += -ol.g[2 + a];
-        if constexpr (LD) cs.Hl[ra] += Hga(NG0, a);
-      }
-      Hpp += Hgg(ID, ID);
-      bp += bg[ID];
-      if constexpr (LD) {
-        cs.Hll += Hgg(NG0, NG0);
-        cs.bl += bg[NG0];
-        hpl += Hgg(ID, NG0);
-      }
-      arena.host += Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol);
-      arena.target(tb) = Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol + KD);
+  CompactProducts<NG> P;
+  const auto& G = P.G;
+  const auto& MG = P.MG;
+  const auto& Hgg = P.Hgg;
+  const auto& Hga = P.Hga;
+  const auto& bg = P.bg;
+  forEachInlier<KD>(m, L, cs, begin, end,
+                    [&](const ObsLin& ol, int hb, int tb, PointArena<KD>& arena, PointSums& ps) {
+    for (int k = 0; k < NG0; ++k) P.G.col(k) = ol.Jg.col(gsrc[k]);
+    if constexpr (LD) P.G.col(NG0) = ol.Jl;
+    P.form(ol);
+    if constexpr (PO) {
+      // The inverse depth's entries alone, as the triangle below forms them.
+      ps.Hpp += G(0, ID) * MG(0, ID) + G(1, ID) * MG(1, ID);
+      P.formGradient(ol);
+      ps.bp += bg[ID];
+      return;
     }
-    L.Hpp[static_cast<size_t>(i)] = Hpp;
-    L.bp[static_cast<size_t>(i)] = bp;
-    L.hpl[static_cast<size_t>(i)] = hpl;
-    arena.done();
-  }
+    P.formUpper(ol);  // upper triangle only (a <= c): all the scatter below reads
+    // Straight into the chunk's blocks: each entry of the host/target blocks receives the same one
+    // addition per observation as through an N x N staging matrix (bit-identical), without writing
+    // and re-reading that matrix. Local index x < KD is the host block, KD <= x < 2 KD the target's,
+    // 2 KD the inverse depth (kept per point for the Schur complement).
+    int row[N];
+    for (int x = 0; x < KD; ++x) row[x] = hb * KD + x, row[KD + x] = tb * KD + x;
+    double* Hd = cs.H.data();
+    const Eigen::Index ld = cs.H.rows();
+    double hcol[N];  // column 2 KD of the local Hessian: d^2 E / d rho d x
+    // Only the upper triangles of Hgg and of cs.H are formed, and linearizePhotometric mirrors cs.H's
+    // to the lower triangle once: half the products and scattered additions of the full form (the
+    // largest cost of a rolling-shutter linearisation, profiled in docs/rolling_shutter.md, "Cost").
+    for (int a = 0; a < ID; ++a) {
+      const int ga = gidx[a];
+      const int ra = row[ga];
+      for (int c = a; c < ID; ++c) {
+        const int rc = row[gidx[c]];
+        Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hgg(a, c);
+      }
+      for (int c = 0; c < 4; ++c) {
+        const int rc = row[aidx[c]];
+        Hd[static_cast<Eigen::Index>(std::max(ra, rc)) * ld + std::min(ra, rc)] += Hga(a, c);
+      }
+      hcol[ga] = Hgg(a, ID);
+      cs.b[ra] += bg[a];
+      if constexpr (LD) cs.Hl[ra] += Hgg(a, NG0);
+    }
+    for (int a = 0; a < 4; ++a) {
+      const int ra = row[aidx[a]];
+      for (int c = 0; c < 4; ++c) {
+        const int rc = row[aidx[c]];
+        if (ra <= rc) Hd[static_cast<Eigen::Index>(rc) * ld + ra] += ol.M(2 + a, 2 + c);
+      }
+      hcol[aidx[a]] = Hga(ID, a);
+      cs.b[ra] += -ol.g[2 + a];
+      if constexpr (LD) cs.Hl[ra] += Hga(NG0, a);
+    }
+    ps.Hpp += Hgg(ID, ID);
+    ps.bp += bg[ID];
+    if constexpr (LD) {
+      cs.Hll += Hgg(NG0, NG0);
+      cs.bl += bg[NG0];
+      ps.hpl += Hgg(ID, NG0);
+    }
+    arena.host += Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol);
+    arena.target(tb) = Eigen::Map<const Eigen::Matrix<double, KD, 1>>(hcol + KD);
+  });
 }
 
 // Rolling shutter, the host pose's blocks from the target pose's. The global-shutter identity below
@@ -211,71 +243,54 @@ void accumulateChunkRolling(BundleAdjuster::Impl& m, Linearization& L, int chunk
   for (int i = 0; i < 6; ++i)
     gsrc[i] = kColTargetPose + i, gsrc[6 + i] = kColHostTwist + i, gsrc[12 + i] = kColTargetTwist + i;
   auto yOf = [](int a) { return a < ID ? a : YL; };  // compact column (not the inverse depth) -> y
-  Eigen::Matrix<double, 2, NG> G, MG;
-  Eigen::Matrix<double, NG, NG> Hgg;
-  Eigen::Matrix<double, NG, 4> Hga;
-  Eigen::Matrix<double, NG, 1> bg;
-  for (int i = begin; i < end; ++i) {
-    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
-    const int hb = p.host->index;
-    double Hpp = 0.0, bp = 0.0, hpl = 0.0;
-    PointArena<KD> arena(L, i, hb);
-    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
-      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
-      if (!countObservation(cs, ol)) continue;
-      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
-      for (int k = 0; k < ID; ++k) G.col(k) = ol.Jg.col(gsrc[k]);
-      G.col(ID) = ol.Jg.col(kColIdepth);
-      if constexpr (LD) G.col(ID + 1) = ol.Jl;
-      MG.noalias() = ol.M.topLeftCorner<2, 2>().lazyProduct(G);
-      for (int a = 0; a < NG; ++a) {  // upper triangle (a <= c)
-        const double g0 = G(0, a), g1 = G(1, a);
-        for (int c = a; c < NG; ++c) Hgg(a, c) = g0 * MG(0, c) + g1 * MG(1, c);
-      }
-      Hga.noalias() = G.transpose().lazyProduct(ol.M.topRightCorner<2, 4>());
-      bg.noalias() = -G.transpose() * ol.g.head<2>();
-      const size_t pi = static_cast<size_t>(hb) * nk + tb;
-      Eigen::Matrix<double, NY, NY>& S = cs.pair_Hr[pi];
-      Eigen::Matrix<double, NY, 1>& sb = cs.pair_br[pi];
-      if (!cs.pair_used[pi]) {
-        S.setZero();
-        sb.setZero();
-        cs.pair_used[pi] = 1;
-      }
-      for (int a = 0; a < NG; ++a) {
-        if (a == ID) continue;
-        const int ya = yOf(a);  // yOf keeps the order, so S gets its upper triangle
-        for (int c = a; c < NG; ++c)
-          if (c != ID) S(ya, yOf(c)) += Hgg(a, c);
-        for (int c = 0; c < 4; ++c) S(ya, YA + c) += Hga(a, c);
-        sb[ya] += bg[a];
-      }
-      for (int a = 0; a < 4; ++a) {
-        for (int c = a; c < 4; ++c) S(YA + a, YA + c) += ol.M(2 + a, 2 + c);
-        sb[YA + a] -= ol.g[2 + a];
-      }
-      Hpp += Hgg(ID, ID);
-      bp += bg[ID];
-      if constexpr (LD) hpl += Hgg(ID, ID + 1);
-      // The point's coupling to its host block (pose through the adjoint, twist, affine (a_h, b_h))
-      // and to the target block (pose, twist, affine (a_t, b_t)).
-      Eigen::Matrix<double, ID, 1> hc;  // d^2 E / d rho d (target pose, host twist, target twist)
-      for (int k = 0; k < ID; ++k) hc[k] = Hgg(k, ID);
-      const Eigen::Vector4d ha = Hga.row(ID).transpose();
-      const Mat6& A = L.pair_adj[pi];
-      arena.host.segment<6>(StateLayout::kPose).noalias() -= A.transpose() * hc.head<6>();
-      arena.host.segment<6>(StateLayout::kTwist) += hc.segment<6>(6);
-      arena.host.segment<2>(StateLayout::kAffine) += ha.head<2>();
-      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t = arena.target(tb);
-      h_t.segment<6>(StateLayout::kPose) = hc.head<6>();
-      h_t.segment<6>(StateLayout::kTwist) = hc.segment<6>(12);
-      h_t.segment<2>(StateLayout::kAffine) = ha.tail<2>();
+  CompactProducts<NG> P;
+  const auto& Hgg = P.Hgg;
+  const auto& Hga = P.Hga;
+  const auto& bg = P.bg;
+  forEachInlier<KD>(m, L, cs, begin, end,
+                    [&](const ObsLin& ol, int hb, int tb, PointArena<KD>& arena, PointSums& ps) {
+    for (int k = 0; k < ID; ++k) P.G.col(k) = ol.Jg.col(gsrc[k]);
+    P.G.col(ID) = ol.Jg.col(kColIdepth);
+    if constexpr (LD) P.G.col(ID + 1) = ol.Jl;
+    P.form(ol);
+    P.formUpper(ol);  // upper triangle (a <= c)
+    const size_t pi = static_cast<size_t>(hb) * nk + tb;
+    Eigen::Matrix<double, NY, NY>& S = cs.pair_Hr[pi];
+    Eigen::Matrix<double, NY, 1>& sb = cs.pair_br[pi];
+    if (!cs.pair_used[pi]) {
+      S.setZero();
+      sb.setZero();
+      cs.pair_used[pi] = 1;
     }
-    L.Hpp[static_cast<size_t>(i)] = Hpp;
-    L.bp[static_cast<size_t>(i)] = bp;
-    L.hpl[static_cast<size_t>(i)] = hpl;
-    arena.done();
-  }
+    for (int a = 0; a < NG; ++a) {
+      if (a == ID) continue;
+      const int ya = yOf(a);  // yOf keeps the order, so S gets its upper triangle
+      for (int c = a; c < NG; ++c)
+        if (c != ID) S(ya, yOf(c)) += Hgg(a, c);
+      for (int c = 0; c < 4; ++c) S(ya, YA + c) += Hga(a, c);
+      sb[ya] += bg[a];
+    }
+    for (int a = 0; a < 4; ++a) {
+      for (int c = a; c < 4; ++c) S(YA + a, YA + c) += ol.M(2 + a, 2 + c);
+      sb[YA + a] -= ol.g[2 + a];
+    }
+    ps.Hpp += Hgg(ID, ID);
+    ps.bp += bg[ID];
+    if constexpr (LD) ps.hpl += Hgg(ID, ID + 1);
+    // The point's coupling to its host block (pose through the adjoint, twist, affine (a_h, b_h))
+    // and to the target block (pose, twist, affine (a_t, b_t)).
+    Eigen::Matrix<double, ID, 1> hc;  // d^2 E / d rho d (target pose, host twist, target twist)
+    for (int k = 0; k < ID; ++k) hc[k] = Hgg(k, ID);
+    const Eigen::Vector4d ha = Hga.row(ID).transpose();
+    const Mat6& A = L.pair_adj[pi];
+    arena.host.segment<6>(StateLayout::kPose).noalias() -= A.transpose() * hc.head<6>();
+    arena.host.segment<6>(StateLayout::kTwist) += hc.segment<6>(6);
+    arena.host.segment<2>(StateLayout::kAffine) += ha.head<2>();
+    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t = arena.target(tb);
+    h_t.segment<6>(StateLayout::kPose) = hc.head<6>();
+    h_t.segment<6>(StateLayout::kTwist) = hc.segment<6>(12);
+    h_t.segment<2>(StateLayout::kAffine) = ha.tail<2>();
+  });
 }
 
 // accumulateChunkRolling's pair sums, added over the chunks in chunk order, into L.Hcc and L.bc (upper
@@ -367,55 +382,43 @@ void accumulateChunkGlobal(BundleAdjuster::Impl& m, Linearization& L, int chunk)
   Eigen::Matrix<double, 7, 7> Hgg;
   Eigen::Matrix<double, 7, 4> Hga;
   Eigen::Matrix<double, 7, 1> bg;
-  for (int i = begin; i < end; ++i) {
-    const ActivePoint& p = *m.points[static_cast<size_t>(i)];
-    const int hb = p.host->index;
-    double Hpp = 0.0, bp = 0.0;
-    PointArena<KD> arena(L, i, hb);
-    for (int r = m.point_obs_begin[static_cast<size_t>(i)]; r < m.point_obs_begin[static_cast<size_t>(i) + 1]; ++r) {
-      const ObsLin& ol = L.obs[static_cast<size_t>(r)];
-      if (!countObservation(cs, ol)) continue;
-      G.leftCols<6>() = ol.Jg.block<2, 6>(0, kColTargetPose);
-      G.col(6) = ol.Jg.col(kColIdepth);
-      MG.noalias() = ol.M.topLeftCorner<2, 2>().lazyProduct(G);
-      if constexpr (PO) {
-        Hpp += G(0, 6) * MG(0, 6) + G(1, 6) * MG(1, 6);
-        bp += -(G(0, 6) * ol.g[0] + G(1, 6) * ol.g[1]);
-        continue;
-      }
-      Hgg.noalias() = G.transpose().lazyProduct(MG);
-      Hga.noalias() = G.transpose().lazyProduct(ol.M.topRightCorner<2, 4>());
-      bg.noalias() = -G.transpose() * ol.g.head<2>();
-      const int tb = p.obs[static_cast<size_t>(m.obs_refs[static_cast<size_t>(r)].obs)].target->index;
-      const size_t pi = static_cast<size_t>(hb) * nk + tb;
-      Eigen::Matrix<double, 10, 10>& S = cs.pair_H[pi];
-      Eigen::Matrix<double, 10, 1>& sb = cs.pair_b[pi];
-      if (!cs.pair_used[pi]) {
-        S.setZero();
-        sb.setZero();
-        cs.pair_used[pi] = 1;
-      }
-      S.topLeftCorner<6, 6>() += Hgg.topLeftCorner<6, 6>();
-      S.block<6, 4>(0, 6) += Hga.topRows<6>();
-      S.bottomRightCorner<4, 4>() += ol.M.bottomRightCorner<4, 4>();
-      sb.head<6>() += bg.head<6>();
-      sb.tail<4>() -= ol.g.tail<4>();
-      Hpp += Hgg(6, 6);
-      bp += bg[6];
-      // The point's coupling to its host block (pose through the adjoint, affine (a_h, b_h)) and to the
-      // target block (pose, affine (a_t, b_t)).
-      const Eigen::Matrix<double, 6, 6>& A = L.pair_adj[pi];
-      arena.host.head<6>().noalias() -= A.transpose() * Hgg.col(6).head<6>();
-      arena.host.tail<2>() += Hga.row(6).head<2>().transpose();
-      Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t = arena.target(tb);
-      h_t.head<6>() = Hgg.col(6).head<6>();
-      h_t.tail<2>() = Hga.row(6).tail<2>().transpose();
+  forEachInlier<KD>(m, L, cs, begin, end,
+                    [&](const ObsLin& ol, int hb, int tb, PointArena<KD>& arena, PointSums& ps) {
+    G.leftCols<6>() = ol.Jg.block<2, 6>(0, kColTargetPose);
+    G.col(6) = ol.Jg.col(kColIdepth);
+    MG.noalias() = ol.M.topLeftCorner<2, 2>().lazyProduct(G);
+    if constexpr (PO) {
+      ps.Hpp += G(0, 6) * MG(0, 6) + G(1, 6) * MG(1, 6);
+      ps.bp += -(G(0, 6) * ol.g[0] + G(1, 6) * ol.g[1]);
+      return;
     }
-    L.Hpp[static_cast<size_t>(i)] = Hpp;
-    L.bp[static_cast<size_t>(i)] = bp;
-    L.hpl[static_cast<size_t>(i)] = 0.0;
-    arena.done();
-  }
+    Hgg.noalias() = G.transpose().lazyProduct(MG);
+    Hga.noalias() = G.transpose().lazyProduct(ol.M.topRightCorner<2, 4>());
+    bg.noalias() = -G.transpose() * ol.g.head<2>();
+    const size_t pi = static_cast<size_t>(hb) * nk + tb;
+    Eigen::Matrix<double, 10, 10>& S = cs.pair_H[pi];
+    Eigen::Matrix<double, 10, 1>& sb = cs.pair_b[pi];
+    if (!cs.pair_used[pi]) {
+      S.setZero();
+      sb.setZero();
+      cs.pair_used[pi] = 1;
+    }
+    S.topLeftCorner<6, 6>() += Hgg.topLeftCorner<6, 6>();
+    S.block<6, 4>(0, 6) += Hga.topRows<6>();
+    S.bottomRightCorner<4, 4>() += ol.M.bottomRightCorner<4, 4>();
+    sb.head<6>() += bg.head<6>();
+    sb.tail<4>() -= ol.g.tail<4>();
+    ps.Hpp += Hgg(6, 6);
+    ps.bp += bg[6];
+    // The point's coupling to its host block (pose through the adjoint, affine (a_h, b_h)) and to the
+    // target block (pose, affine (a_t, b_t)).
+    const Eigen::Matrix<double, 6, 6>& A = L.pair_adj[pi];
+    arena.host.head<6>().noalias() -= A.transpose() * Hgg.col(6).head<6>();
+    arena.host.tail<2>() += Hga.row(6).head<2>().transpose();
+    Eigen::Map<Eigen::Matrix<double, KD, 1>> h_t = arena.target(tb);
+    h_t.head<6>() = Hgg.col(6).head<6>();
+    h_t.tail<2>() = Hga.row(6).tail<2>().transpose();
+  });
   if constexpr (PO) return;
   // The pairs' sums into the chunk's camera blocks (state order per block: pose 0-5, affine 6-7).
   for (int h = 0; h < nk; ++h)
