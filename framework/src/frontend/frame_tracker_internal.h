@@ -79,6 +79,7 @@ struct FrameTracker::Attempt {
   std::string failure;
   SE3d T_c_w;
   AffineBrightness affine;
+  Vec6 twist = Vec6::Zero();  // the twist of the last level (TrackerOptions::twist_refresh_levels)
   std::array<double, 6> level_rmse;
   int iterations = 0;
   Attempt() { level_rmse.fill(std::nan("")); }

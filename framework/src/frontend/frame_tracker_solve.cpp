@@ -38,6 +38,7 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
   resetRows();  // every guess starts its row solves afresh: results do not depend on earlier guesses
   a.T_c_w = guess;
   a.affine = info.affine_guess;
+  a.twist = info.twist;
   const double exposure_ratio = exposureRatio(ref_.exposure_ms, info.exposure_ms);
   const int coarsest = std::min(static_cast<int>(levels_.size()), frame.numLevels()) - 1;
   bool repeated = false;
@@ -45,10 +46,10 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
   for (int lvl = coarsest; lvl >= 0; --lvl) {
     const ImageLevel& img = frame.level(lvl);
     double cutoff_mult = 1.0;
-    evaluate(img, lvl, RsFrame{a.T_c_w, info.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th, true, lin);
+    evaluate(img, lvl, RsFrame{a.T_c_w, a.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th, true, lin);
     while (lin.saturatedRatio() > 0.6 && cutoff_mult < 50.0) {
       cutoff_mult *= 2.0;
-      evaluate(img, lvl, RsFrame{a.T_c_w, info.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th * cutoff_mult,
+      evaluate(img, lvl, RsFrame{a.T_c_w, a.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th * cutoff_mult,
                true, lin);
     }
     if (lin.num_points == 0) {
@@ -82,7 +83,7 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
       AffineBrightness aff_new = a.affine;
       aff_new.a += inc(6);
       aff_new.b += inc(7);
-      evaluate(img, lvl, RsFrame{T_new, info.twist, info.w_dot}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
+      evaluate(img, lvl, RsFrame{T_new, a.twist, info.w_dot}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
                lin_new);
       ++a.iterations;
       const bool accept = lin_new.num_terms > 0 && lin_new.meanEnergy() < lin.meanEnergy();
@@ -106,6 +107,11 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
     if (cutoff_mult > 1.0 && !repeated) {
       ++lvl;
       repeated = true;
+    }
+    // The rate through the pose reached, for the finer levels (TrackerOptions::twist_refresh_levels).
+    if (lvl >= 1 && lvl <= options_.twist_refresh_levels && info.rotation_rate_of_pose) {
+      const Vec3 w = info.rotation_rate_of_pose(a.T_c_w);
+      if (w.allFinite()) a.twist.tail<3>() = w;
     }
   }
   a.ok = std::isfinite(a.level_rmse[0]) && a.T_c_w.translation().allFinite();
@@ -152,10 +158,13 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
   }
   res.T_c_w = best.T_c_w;
   res.affine = best.affine;
+  res.twist = best.twist;
   res.level_rmse = best.level_rmse;
 
-  // Lost tests on the winner, at level 0 with the base cutoff.
-  const LevelEnergy e = levelEnergy(frame, info, 0, best.T_c_w, best.affine);
+  // Lost tests on the winner, at level 0 with the base cutoff and its twist.
+  TrackingFrame info_best = info;
+  info_best.twist = best.twist;
+  const LevelEnergy e = levelEnergy(frame, info_best, 0, best.T_c_w, best.affine);
   res.rmse = e.rmse();
   res.num_points = e.num_points;
   res.inlier_ratio = e.num_terms > 0 ? 1.0 - static_cast<double>(e.num_saturated) / e.num_terms : 0.0;
@@ -236,6 +245,10 @@ ParamTable TrackerOptions::paramTable() {
                "rolling shutter: a tracked frame is tracked again this many times from the pose it reached, with "
                "the twist's rotation re-estimated as the rate through that pose (0: never; not when the IMU "
                "gives the rotation)"),
+      paramInt("track_twist_refresh_levels", d.twist_refresh_levels, 0, 5, "",
+               "rolling shutter: within each pass the twist's rotation is re-estimated as the rate through the "
+               "pose reached after each of the pyramid levels this number .. 1 (0: never; not when the IMU gives "
+               "the rotation)"),
   };
 }
 
@@ -251,6 +264,7 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.min_explained_ratio = p.getDouble("track_min_explained_ratio");
   o.twist_retries = static_cast<int>(p.getInt("track_twist_retries"));
   o.twist_refinements = static_cast<int>(p.getInt("track_twist_refinements"));
+  o.twist_refresh_levels = static_cast<int>(p.getInt("track_twist_refresh_levels"));
   return o;
 }
 

@@ -16,6 +16,9 @@ Tracking::Tracking(const TrackerOptions& options, const CameraModel& camera, con
 TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_in, bool* ok) {
   auto good = [](const TrackResult& r) { return r.ok() && r.T_c_w.translation().allFinite(); };
   TrackingFrame info = info_in;
+  const bool rolling_unmeasured = timing_.dtDv() != 0.0 && !info.twist_measured && history_.size() >= 2;
+  if (rolling_unmeasured && tracker_->options().twist_refresh_levels > 0)
+    info.rotation_rate_of_pose = [this, t = info.t_ns](const SE3d& T) { return rotationRateAt(t, &T); };
   const std::vector<SE3d> g = guesses(info.t_ns);
   TrackResult r = tracker_->track(pyr, info, g);
   *ok = good(r);
@@ -40,7 +43,7 @@ TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_i
   // the pose just found, extrapolated to the frame's time, is nearer the truth, and the frame is tracked
   // again with it from that pose. A refinement that does not track keeps the result before it. Needs two
   // frames of history (the rate through one interval would lag as the prediction does).
-  const bool refine = timing_.dtDv() != 0.0 && !info.twist_measured && history_.size() >= 2;
+  const bool refine = rolling_unmeasured;
   for (int k = 0; refine && k < twist_refinements_; ++k) {
     const SE3d T = r.T_c_w;
     info.twist.tail<3>() = rotationRateAt(info.t_ns, &T);

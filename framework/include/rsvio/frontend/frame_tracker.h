@@ -47,6 +47,7 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -93,6 +94,10 @@ struct TrackerOptions {
   // twist's rotation re-estimated as the rate through that pose (Tracking::track; skipped when the
   // rotation is measured, TrackingFrame::twist_measured). docs/rolling_shutter.md, "Twist refinement".
   int twist_refinements = 1;
+  // Rolling shutter: within each guess's coarse-to-fine pass, the twist's rotation is set to
+  // TrackingFrame::rotation_rate_of_pose(pose reached) after each of the levels this number .. 1, so
+  // the finer levels are solved with the rate through the pose found so far (0: the twist stays fixed).
+  int twist_refresh_levels = 0;
 
   static ParamTable paramTable();                   // keys track_* (see frontend_options.h)
   // Reads the track_* keys; `residual` is left for the caller (ResidualOptions::fromParams).
@@ -124,6 +129,9 @@ struct TrackingFrame {
   Vec6 twist = Vec6::Zero();            // kept fixed (prior or previous frame)
   bool twist_measured = false;          // its rotation is the gyroscope's: Tracking does not refine it
   Vec3 w_dot = Vec3::Zero();            // RsFrame::w_dot, kept fixed (the gyroscope's; zero without it)
+  // TrackerOptions::twist_refresh_levels: the twist's rotation as a function of the frame's central
+  // pose T_c_w (rad/s, camera frame); empty: the twist is held.
+  std::function<Vec3(const SE3d&)> rotation_rate_of_pose;
   double exposure_ms = std::numeric_limits<double>::quiet_NaN();
   AffineBrightness affine_guess;        // usually the previous frame's
 };
@@ -134,6 +142,7 @@ struct TrackResult {
   std::string reason;                   // empty when Ok; one line otherwise
   SE3d T_c_w;                           // central pose of the new frame
   AffineBrightness affine;
+  Vec6 twist = Vec6::Zero();            // the twist the result was tracked with (TrackingFrame::twist, or refreshed)
   double rmse = 0.0;                    // level 0, intensity units
   std::array<double, 6> level_rmse{};   // per level (NaN where not reached)
   double inlier_ratio = 0.0;            // level 0, |r| <= cutoff
