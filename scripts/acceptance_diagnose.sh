@@ -16,6 +16,7 @@
 # compares unequal spans when the before run failed. ROUNDS=2 diagnoses every after-run once more.
 # time_offset (time_offset.json: 15 ms) and clean_vio start from configs/default.json (visual-inertial,
 # offset not estimated): run them with EFFECTS="time_offset" CLEAN="clean_vio".
+# START=default (a config name under configs/) starts every case from that config instead.
 # The "before" model is configs/gs_vo.json for the visual effects; for exposure without affine
 # brightness (--set photometric.affine=null), since gs_vo already models it (rs_exposure too).
 set -euo pipefail
@@ -50,7 +51,10 @@ simname() { case "$1" in rs_exposure) echo rs_exposure ;; *) basename "$(simcfg 
 # suffices and the second gives none), else 1 unless ROUNDS says otherwise (ROUNDS=2 checks that the
 # second diagnosis gives none).
 rounds() { case "$1" in rs_exposure|vignetting) echo 3 ;; *) echo "${ROUNDS:-1}" ;; esac; }
-model() { case "$1" in time_offset|clean_vio) echo "$CFG/default.json" ;; *) echo "$CFG/gs_vo.json" ;; esac; }
+model() {
+  if [ -n "${START:-}" ]; then echo "$CFG/$START.json"; return; fi
+  case "$1" in time_offset|clean_vio) echo "$CFG/default.json" ;; *) echo "$CFG/gs_vo.json" ;; esac
+}
 base_sets() { case "$1" in exposure|rs_exposure|clean_noaffine) echo "--set photometric.affine=null" ;; esac; }
 
 field() {  # field JSON_FILE PYTHON_EXPR
