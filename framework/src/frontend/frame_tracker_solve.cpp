@@ -108,7 +108,8 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
       ++lvl;
       repeated = true;
     }
-    // The rate through the pose reached, for the finer levels (TrackerOptions::twist_refresh_levels).
+    // The rate through the pose reached, for the next level solved, lvl - 1 (a finer one, or this one
+    // again when DSO repeats it): TrackerOptions::twist_refresh_levels.
     if (lvl >= 1 && lvl <= options_.twist_refresh_levels && info.rotation_rate_of_pose) {
       const Vec3 w = info.rotation_rate_of_pose(a.T_c_w);
       if (w.allFinite()) a.twist.tail<3>() = w;
@@ -247,8 +248,8 @@ ParamTable TrackerOptions::paramTable() {
                "gives the rotation)"),
       paramInt("track_twist_refresh_levels", d.twist_refresh_levels, 0, 5, "",
                "rolling shutter: within each pass the twist's rotation is re-estimated as the rate through the "
-               "pose reached after each of the pyramid levels this number .. 1 (0: never; not when the IMU gives "
-               "the rotation)"),
+               "pose reached before each solve of the pyramid levels below this number (0: never; 1: before level 0; "
+               "not when the IMU gives the rotation)"),
   };
 }
 

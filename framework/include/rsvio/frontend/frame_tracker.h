@@ -95,8 +95,9 @@ struct TrackerOptions {
   // rotation is measured, TrackingFrame::twist_measured). docs/rolling_shutter.md, "Twist refinement".
   int twist_refinements = 1;
   // Rolling shutter: within each guess's coarse-to-fine pass, the twist's rotation is set to
-  // TrackingFrame::rotation_rate_of_pose(pose reached) after each of the levels this number .. 1, so
-  // the finer levels are solved with the rate through the pose found so far (0: the twist stays fixed).
+  // TrackingFrame::rotation_rate_of_pose(pose reached) before each solve of the levels below this number
+  // (a level DSO repeats too), so they are solved with the rate through the pose found so far (0: the
+  // twist stays fixed; 1: before level 0 only).
   int twist_refresh_levels = 0;
 
   static ParamTable paramTable();                   // keys track_* (see frontend_options.h)
