@@ -2,9 +2,9 @@
 # Evaluation side only (reads the dataset's ground truth, as `rsvio eval` does; never the estimator):
 # which time shift d best aligns a run's rotation rates (consecutive trajectory.tum poses: camera
 # frame, or body frame when its header says so) with the true rates over [a + d, b + d]? A
-# global-shutter model on rolling-shutter images fits each frame's pose to the rows where its
-# information sits, not to the middle row, and that looks like a camera-IMU time offset
-# (docs/diagnose.md, "Rolling shutter from configs/default.json"). Python 3, no third-party modules.
+# global-shutter model on rolling-shutter images does not give the middle row's pose, and that can
+# look like a camera-IMU time offset (docs/diagnose.md, "Rolling shutter from configs/default.json").
+# Python 3, no third-party modules.
 #
 #   python3 scripts/rotation_time_shift.py RUN_DIR DATASET_DIR      (EuRoC layout with ground truth)
 # Prints the RMS rate misfit at d = 0 and the best d over -40 .. +40 ms in 2 ms steps.
