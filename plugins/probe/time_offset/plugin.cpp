@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "../common/probe_common.h"
@@ -90,7 +91,8 @@ class TimeOffsetProbe : public DiagnosticProbe {
  public:
   explicit TimeOffsetProbe(const Params& p)
       : threshold_(p.getDouble("threshold")), min_explained_(p.getDouble("min_explained")), block_s_(p.getDouble("block_s")),
-        max_gap_(p.getDouble("max_gap_frames")), curve_ms_(p.getDouble("curve_range_ms")) {}
+        max_gap_(p.getDouble("max_gap_frames")), curve_ms_(p.getDouble("curve_range_ms")),
+        min_blocks_(static_cast<int>(p.getInt("min_blocks"))) {}
   std::string effect() const override { return "time_offset"; }
 
   ProbeResult evaluate(const ProbeInput& in) const override {
@@ -149,6 +151,21 @@ class TimeOffsetProbe : public DiagnosticProbe {
       ProbeResult r = probe::tooLittleData(effect(), kPlugin, rows.size(), 1.0);
       r.explanation = "too little data (" + std::to_string(rows.size()) +
                       " frame pairs with IMU data around them; at least 20 are needed)";
+      return r;
+    }
+    // The robust standard error below is formed from one score sum per block: with G blocks it has
+    // G - 1 degrees of freedom, and on 3 blocks (1.5 s) |z| 6.9 is p ~ 0.02 (t with 2 dof), not a test.
+    // Measured: gs_vio's first second on rolling-shutter images (lost at frame 29, 3 blocks) gave |z|
+    // 6.9 for a 13.6 ms offset that is not there (docs/diagnose.md, "Rolling shutter from
+    // configs/default.json").
+    std::set<int> blocks;
+    for (const PairRow& p : rows) blocks.insert(p.block);
+    if (static_cast<int>(blocks.size()) < min_blocks_) {
+      ProbeResult r = probe::tooLittleData(effect(), kPlugin, rows.size(), 1.0);
+      std::ostringstream ex;
+      ex << "too little data (" << blocks.size() << " blocks of " << block_s_ << " s with frame pairs; at least "
+         << min_blocks_ << " are needed for the robust standard error)";
+      r.explanation = ex.str();
       return r;
     }
     // Residual and regressor at shift d, with the per-axis constant (bias) removed.
@@ -250,6 +267,7 @@ class TimeOffsetProbe : public DiagnosticProbe {
 
  private:
   double threshold_, min_explained_, block_s_, max_gap_, curve_ms_;
+  int min_blocks_;
 };
 
 ParamTable table() {
@@ -259,7 +277,10 @@ ParamTable table() {
           paramDouble("block_s", 0.5, 0.05, 60.0, "s", "frame pairs are grouped in blocks this long for the robust standard error"),
           paramDouble("max_gap_frames", 1.5, 1.0, 100.0, "",
                       "a pair of tracked frames further apart than this many median frame periods is skipped"),
-          paramDouble("curve_range_ms", 40.0, 1.0, 1000.0, "ms", "the evidence curve covers shifts of +- this much")};
+          paramDouble("curve_range_ms", 40.0, 1.0, 1000.0, "ms", "the evidence curve covers shifts of +- this much"),
+          paramInt("min_blocks", 4, 2, 1000, "",
+                   "fewer blocks with frame pairs: too little data (the robust standard error has blocks - 1 degrees "
+                   "of freedom)")};
 }
 
 void registerAll(PluginRegistrar& r) {

@@ -2,7 +2,8 @@
 // axis), a gyroscope at 200 Hz with a bias and white noise, and a 20 Hz trajectory with a little pose
 // noise. The IMU clock is shifted by a known offset; the probe must measure it, name it, and stay quiet
 // without one. Also: the camera-frame path (R_B_C and the calibration's offset applied), the gate on a
-// visual rotation that misfits the gyro at every shift, and the inputs it needs.
+// visual rotation that misfits the gyro at every shift, the blocks the robust error needs, and the
+// inputs it needs.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -133,6 +134,23 @@ TEST(TimeOffsetProbe, APoorVisualRotationIsNotAnOffset) {
   const ProbeResult p = evaluate(makeRun(0.0, 2e-4, 0.5, false, 7));
   EXPECT_LT(p.details["explained_fraction"].get<double>(), 0.25) << p.explanation;
   EXPECT_LT(p.score, 1.0) << p.explanation;
+}
+
+// The robust standard error has one score sum per block of block_s (0.5 s): on 1.5 s of frame pairs (3
+// blocks, 2 degrees of freedom) the probe says too little data even for a clear 15 ms offset, on 2 s (4
+// blocks, min_blocks) it names it. A global-shutter run's first second on rolling-shutter images gave
+// |z| 6.9 on 3 blocks for an offset that was not there (docs/diagnose.md).
+TEST(TimeOffsetProbe, NeedsFourBlocksOfFramePairs) {
+  SyntheticRun r = makeRun(0.015, 2e-4, 0.0, false, 3);
+  const std::vector<io::StampedPose> all = r.traj.poses;
+  r.traj.poses.assign(all.begin(), all.begin() + 31);  // 30 pairs over 1.5 s
+  ProbeResult p = evaluate(r);
+  EXPECT_EQ(p.score, 0.0) << p.explanation;
+  EXPECT_EQ(p.explanation.rfind("too little data (3 blocks", 0), 0u) << p.explanation;
+  r.traj.poses.assign(all.begin(), all.begin() + 41);  // 40 pairs over 2 s
+  p = evaluate(r);
+  EXPECT_GT(p.score, 1.0) << p.explanation;
+  EXPECT_EQ(p.details["blocks"].get<int>(), 4);
 }
 
 TEST(TimeOffsetProbe, NeedsTheImuAndTheTrajectoryAndIsNotApplicableWhenModelled) {
