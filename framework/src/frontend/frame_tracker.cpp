@@ -104,7 +104,12 @@ void FrameTracker::resetRows() const {
 // (v <- v + (pi_v - v) / (1 - a_v), a = J (xi_v + xi_w x P) dt/dv) with only the Jacobian the tracker
 // needs, d uv / d T0 = M J R(xi t) [I, -[P0]x], M = (I - a e_v^T)^-1, and the row of the previous
 // evaluation as the start (reset for every guess).
-void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize) const {
+//
+// With `rate` the block also gets E = d uv / d w (w the twist's rotation, rad/s): at the row time t,
+// exp((xi + (0; dw)) t) P0 = P + t dw x P up to the left Jacobian of xi t (|w t| ~ 1e-2 rad over a
+// readout: a 1 % error in a Gauss-Newton direction, not in the residual), so d P / d w = -t [P]x, and
+// the row's dependence enters as for D: E = M J (-t [P]x).
+void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize, bool rate) const {
   const Eigen::Index n = B.X_w.cols();
   const Eigen::Matrix3d R = target.T_c_w0.rotationMatrix();
   const Vec3 t = target.T_c_w0.translation();
@@ -112,6 +117,8 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
   for (Eigen::Index i = 0; i < n; ++i) B.P0.col(i) = R * B.X_w.col(i) + t;
   if (linearize) B.D.resize(static_cast<size_t>(n));
   const double c = timing_.dtDv();
+  rate = rate && linearize && c != 0.0;
+  if (rate) B.E.resize(static_cast<size_t>(n));
   if (c == 0.0) {
     camera_.project(B.P0, B.uv, B.valid, linearize ? &B.J : nullptr);
     if (linearize)
@@ -174,6 +181,12 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
         D.row(0) += (a.x() * inv) * D.row(1);
         D.row(1) *= inv;
         B.D[si] = D;
+        if (rate) {
+          Jac23 E = J * (-ti * SO3d::hat(Pk));
+          E.row(0) += (a.x() * inv) * E.row(1);
+          E.row(1) *= inv;
+          B.E[si] = E;
+        }
       }
     }
     B.active.swap(B.still);
@@ -182,7 +195,7 @@ void FrameTracker::projectBlock(Block& B, const RsFrame& target, bool linearize)
 }
 
 void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
-                            double exposure_ratio, double cutoff, bool linearize, Linearization& out) const {
+                            double exposure_ratio, double cutoff, bool linearize, Linearization& out, bool rate) const {
   LevelPoints& L = *levels_[static_cast<size_t>(level)];
   const double alpha = exposure_ratio * std::exp(aff.a - ref_.affine.a);
   const double beta = aff.b - alpha * ref_.affine.b;
@@ -198,7 +211,7 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
     Linearization& acc = B.lin;
     acc.setZero();
     const Eigen::Index n = B.X_w.cols();
-    projectBlock(B, target, linearize);  // uv (level 0) and d uv / d T0
+    projectBlock(B, target, linearize, rate);  // uv (level 0), d uv / d T0 (and d uv / d w)
     PatternResidual res;
     for (Eigen::Index i = 0; i < n; ++i) {
       if (!B.valid[static_cast<size_t>(i)]) continue;
@@ -265,6 +278,14 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
       acc.b.head<6>().noalias() += D.transpose() * Vec2(grx, gry);
       acc.b(6) += cr;
       acc.b(7) += r1;
+      if (rate && timing_.dtDv() != 0.0) {
+        const Jac23& E = B.E[static_cast<size_t>(i)];
+        acc.H.block<6, 3>(0, 8).noalias() += D.transpose() * G * E;
+        acc.H.block<1, 3>(6, 8).noalias() += Vec2(gcx, gcy).transpose() * E;
+        acc.H.block<1, 3>(7, 8).noalias() += Vec2(g1x, g1y).transpose() * E;
+        acc.H.block<3, 3>(8, 8).noalias() += E.transpose() * G * E;
+        acc.b.tail<3>().noalias() += E.transpose() * Vec2(grx, gry);
+      }
     }
   };
   runner_->run(static_cast<int>(L.blocks.size()), runBlock);
@@ -272,13 +293,14 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
   out.setZero();
   for (const Block& B : L.blocks) out.add(B.lin);  // fixed order: identical for any thread count
   // Mirror the upper triangle that was accumulated.
-  for (int i = 0; i < 8; ++i)
-    for (int j = i + 1; j < 8; ++j) out.H(j, i) = out.H(i, j);
+  for (int i = 0; i < kTrackDim; ++i)
+    for (int j = i + 1; j < kTrackDim; ++j) out.H(j, i) = out.H(i, j);
 }
 
 void FrameTracker::projectReference(int level, const SE3d& T_c_w, const Vec6& twist, Eigen::Matrix2Xd* uv,
                                     std::vector<uint8_t>* valid, std::vector<Eigen::Matrix<double, 2, 6>>* d_uv_d_T,
-                                    Eigen::Matrix3Xd* X_w, const Vec3& w_dot) const {
+                                    Eigen::Matrix3Xd* X_w, const Vec3& w_dot,
+                                    std::vector<Eigen::Matrix<double, 2, 3>>* d_uv_d_w) const {
   if (!hasReference()) throw Error("FrameTracker::projectReference: no reference keyframe");
   LevelPoints& L = *levels_.at(static_cast<size_t>(level));
   resetRows();
@@ -286,14 +308,17 @@ void FrameTracker::projectReference(int level, const SE3d& T_c_w, const Vec6& tw
   if (X_w) X_w->resize(3, L.n);
   valid->assign(static_cast<size_t>(L.n), 0);
   if (d_uv_d_T) d_uv_d_T->assign(static_cast<size_t>(L.n), Mat26::Zero());
+  const bool rate = d_uv_d_T && d_uv_d_w && timing_.dtDv() != 0.0;
+  if (d_uv_d_w) d_uv_d_w->assign(static_cast<size_t>(L.n), Jac23::Zero());
   for (Block& B : L.blocks) {
-    projectBlock(B, RsFrame{T_c_w, twist, w_dot}, d_uv_d_T != nullptr);
+    projectBlock(B, RsFrame{T_c_w, twist, w_dot}, d_uv_d_T != nullptr, rate);
     for (Eigen::Index i = 0; i < B.X_w.cols(); ++i) {
       const size_t j = static_cast<size_t>(B.begin + i);
       if (X_w) X_w->col(static_cast<Eigen::Index>(j)) = B.X_w.col(i);
       uv->col(static_cast<Eigen::Index>(j)) = B.uv.col(i);
       (*valid)[j] = B.valid[static_cast<size_t>(i)];
       if (d_uv_d_T && B.valid[static_cast<size_t>(i)]) (*d_uv_d_T)[j] = B.D[static_cast<size_t>(i)];
+      if (rate && B.valid[static_cast<size_t>(i)]) (*d_uv_d_w)[j] = B.E[static_cast<size_t>(i)];
     }
   }
 }

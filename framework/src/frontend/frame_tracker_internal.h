@@ -14,17 +14,21 @@ namespace rsvio {
 // Points per block of the deterministic parallel sums (fixed: results do not depend on threads).
 constexpr int kBlockPoints = 128;
 
-using Mat88 = Eigen::Matrix<double, 8, 8>;
-using Vec8 = Eigen::Matrix<double, 8, 1>;
+// The tracker's unknowns: left pose increment (6; translation, rotation), affine a, b, and with
+// TrackerOptions::rotation_rate_sigma > 0 the twist's rotation (3, rad/s).
+constexpr int kTrackDim = 11;
+using MatT = Eigen::Matrix<double, kTrackDim, kTrackDim>;
+using VecT = Eigen::Matrix<double, kTrackDim, 1>;
 
 // Rolling-shutter row solve in the tracker: tolerance and iteration cap (rs_projection.h's method).
 constexpr double kRowLinearStepPx = 0.05;  // Newton steps below this are applied linearly (see projectBlock)
 constexpr int kRowMaxIterations = 10;
 
-// Normal equations of (delta(6), a, b) on one level, with energy statistics.
+// Normal equations of (delta(6), a, b, dw(3)) on one level, with energy statistics (the dw block
+// stays zero unless the rate is estimated).
 struct FrameTracker::Linearization {
-  Mat88 H = Mat88::Zero();
-  Vec8 b = Vec8::Zero();
+  MatT H = MatT::Zero();
+  VecT b = VecT::Zero();
   double energy = 0.0;
   int num_terms = 0;
   int num_saturated = 0;
@@ -60,6 +64,7 @@ struct FrameTracker::Block {
   std::vector<uint8_t> valid, valid_a;
   std::vector<Jac23> J;
   std::vector<Mat26> D;           // d uv / d T0 (left), row dependence included
+  std::vector<Jac23> E;           // d uv / d w (the twist's rotation), row dependence included (rate estimated)
   std::vector<double> row;        // rolling shutter: Newton's row per point (warm start within a guess)
   std::vector<int> active, still;
   FrameTracker::Linearization lin;

@@ -14,11 +14,13 @@ namespace {
 
 // DSO's increment scaling (SCALE_XI_TRANS = 0.5, SCALE_XI_ROT = 1, SCALE_A = 10, SCALE_B = 1000):
 // the convergence test is on the increment in these units.
-double scaledNorm(const Vec8& inc) {
-  Vec8 s = inc;
+// The rate's increment counts as the rotation it makes over rate_time_s (half the readout).
+double scaledNorm(const VecT& inc, double rate_time_s) {
+  VecT s = inc;
   s.head<3>() /= 0.5;
   s(6) /= 10.0;
   s(7) /= 1000.0;
+  s.tail<3>() *= rate_time_s;
   return s.norm();
 }
 
@@ -43,37 +45,55 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
   const int coarsest = std::min(static_cast<int>(levels_.size()), frame.numLevels()) - 1;
   bool repeated = false;
   Linearization lin, lin_new;
+  // Rolling shutter, TrackerOptions::rotation_rate_sigma: the twist's rotation is estimated too, with a
+  // prior about the given rate; its weight in the energy's units is the level's mean energy per term
+  // at the level's start (the residual variance) over sigma^2, energy sum w r^2 + lambda_w |w - w0|^2.
+  const bool rate = info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
+  const Vec3 w_prior = info.twist.tail<3>();
+  const double rate_time = 0.5 * std::abs(timing_.dtDv()) * std::max(1.0, 2.0 * timing_.y0);
   for (int lvl = coarsest; lvl >= 0; --lvl) {
     const ImageLevel& img = frame.level(lvl);
     double cutoff_mult = 1.0;
-    evaluate(img, lvl, RsFrame{a.T_c_w, a.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th, true, lin);
+    evaluate(img, lvl, RsFrame{a.T_c_w, a.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th, true, lin, rate);
     while (lin.saturatedRatio() > 0.6 && cutoff_mult < 50.0) {
       cutoff_mult *= 2.0;
       evaluate(img, lvl, RsFrame{a.T_c_w, a.twist, info.w_dot}, a.affine, exposure_ratio, options_.cutoff_th * cutoff_mult,
-               true, lin);
+               true, lin, rate);
     }
     if (lin.num_points == 0) {
       a.failure = "no reference point in view on level " + std::to_string(lvl);
       return a;
     }
     double lambda = options_.lambda_initial;
+    const double lambda_w = rate ? lin.meanEnergy() / (options_.rotation_rate_sigma * options_.rotation_rate_sigma) : 0.0;
+    auto priorEnergy = [&](const Vec3& w) { return lambda_w * (w - w_prior).squaredNorm(); };
+    auto totalMean = [&](const Linearization& l, const Vec3& w) {
+      return l.num_terms > 0 ? (l.energy + priorEnergy(w)) / l.num_terms : std::nan("");
+    };
     const int max_it = options_.max_iterations[static_cast<size_t>(std::min(lvl, 5))];
     for (int it = 0; it < max_it; ++it) {
-      Mat88 Hl = lin.H;
-      for (int i = 0; i < 8; ++i) Hl(i, i) *= (1.0 + lambda);
-      // Fixed brightness parameters: drop their rows and columns.
+      MatT Hl = lin.H;
+      for (int i = 0; i < kTrackDim; ++i) Hl(i, i) *= (1.0 + lambda);
+      VecT bl = lin.b;
+      if (rate) {
+        Hl.bottomRightCorner<3, 3>().diagonal().array() += lambda_w;
+        bl.tail<3>() += lambda_w * (a.twist.tail<3>() - w_prior);
+      }
+      // Fixed brightness parameters (and a fixed rate): drop their rows and columns.
       int dim = 6;
-      int idx[8] = {0, 1, 2, 3, 4, 5, -1, -1};
+      int idx[kTrackDim] = {0, 1, 2, 3, 4, 5, -1, -1, -1, -1, -1};
       if (options_.estimate_a) idx[dim++] = 6;
       if (options_.estimate_b) idx[dim++] = 7;
+      if (rate)
+        for (int k = 8; k < kTrackDim; ++k) idx[dim++] = k;
       Eigen::MatrixXd Hr(dim, dim);
       Eigen::VectorXd br(dim);
       for (int i = 0; i < dim; ++i) {
-        br(i) = lin.b(idx[i]);
+        br(i) = bl(idx[i]);
         for (int j = 0; j < dim; ++j) Hr(i, j) = Hl(idx[i], idx[j]);
       }
       const Eigen::VectorXd xr = Hr.ldlt().solve(-br);
-      Vec8 inc = Vec8::Zero();
+      VecT inc = VecT::Zero();
       for (int i = 0; i < dim; ++i) inc(idx[i]) = xr(i);
       // DSO's extrapolation when lambda is small: a slightly longer step.
       if (lambda < 1e-3) inc *= std::sqrt(std::sqrt(1e-3 / lambda));
@@ -83,20 +103,23 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
       AffineBrightness aff_new = a.affine;
       aff_new.a += inc(6);
       aff_new.b += inc(7);
-      evaluate(img, lvl, RsFrame{T_new, a.twist, info.w_dot}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
-               lin_new);
+      Vec6 twist_new = a.twist;
+      twist_new.tail<3>() += inc.tail<3>();
+      evaluate(img, lvl, RsFrame{T_new, twist_new, info.w_dot}, aff_new, exposure_ratio, options_.cutoff_th * cutoff_mult, true,
+               lin_new, rate);
       ++a.iterations;
-      const bool accept = lin_new.num_terms > 0 && lin_new.meanEnergy() < lin.meanEnergy();
+      const bool accept = lin_new.num_terms > 0 && totalMean(lin_new, twist_new.tail<3>()) < totalMean(lin, a.twist.tail<3>());
       if (accept) {
         std::swap(lin, lin_new);
         a.T_c_w = T_new;
         a.affine = aff_new;
+        a.twist = twist_new;
         lambda *= 0.5;
       } else {
         lambda *= 4.0;
         if (lambda < 1e-3) lambda = 1e-3;
       }
-      if (!(scaledNorm(inc) > options_.converge_eps)) break;
+      if (!(scaledNorm(inc, rate_time) > options_.converge_eps)) break;
     }
     a.level_rmse[static_cast<size_t>(lvl)] = std::sqrt(lin.meanEnergy());
     if (a.level_rmse[static_cast<size_t>(lvl)] > options_.abort_factor * abort_rmse[static_cast<size_t>(lvl)]) {
@@ -160,6 +183,7 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
   res.T_c_w = best.T_c_w;
   res.affine = best.affine;
   res.twist = best.twist;
+  res.rate_estimated = info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
   res.level_rmse = best.level_rmse;
 
   // Lost tests on the winner, at level 0 with the base cutoff and its twist.
@@ -246,6 +270,9 @@ ParamTable TrackerOptions::paramTable() {
                "rolling shutter: a tracked frame is tracked again this many times from the pose it reached, with "
                "the twist's rotation re-estimated as the rate through that pose (0: never; not when the IMU "
                "gives the rotation)"),
+      paramDouble("track_rotation_rate_sigma", d.rotation_rate_sigma, 0.0, 100.0, "rad/s",
+                  "rolling shutter: > 0 estimates the twist's rotation with the pose under a prior of this sigma about "
+                  "the predicted rate (0: the twist is held fixed)"),
       paramInt("track_twist_refresh_levels", d.twist_refresh_levels, 0, 5, "",
                "rolling shutter: within each pass the twist's rotation is re-estimated as the rate through the "
                "pose reached before each solve of the pyramid levels below this number (0: never; 1: before level 0; "
@@ -266,6 +293,7 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.twist_retries = static_cast<int>(p.getInt("track_twist_retries"));
   o.twist_refinements = static_cast<int>(p.getInt("track_twist_refinements"));
   o.twist_refresh_levels = static_cast<int>(p.getInt("track_twist_refresh_levels"));
+  o.rotation_rate_sigma = p.getDouble("track_rotation_rate_sigma");
   return o;
 }
 

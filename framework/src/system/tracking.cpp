@@ -17,6 +17,7 @@ TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_i
   auto good = [](const TrackResult& r) { return r.ok() && r.T_c_w.translation().allFinite(); };
   TrackingFrame info = info_in;
   const bool rolling_unmeasured = timing_.dtDv() != 0.0 && !info.twist_measured && history_.size() >= 2;
+  info.estimate_rotation_rate = rolling_unmeasured && tracker_->options().rotation_rate_sigma > 0.0;
   if (rolling_unmeasured && tracker_->options().twist_refresh_levels > 0)
     info.rotation_rate_of_pose = [this, t = info.t_ns](const SE3d& T) { return rotationRateAt(t, &T); };
   const std::vector<SE3d> g = guesses(info.t_ns);

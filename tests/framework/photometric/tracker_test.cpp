@@ -246,11 +246,13 @@ TEST(FrameTracker, OwnProjectionMatchesRsProjectionAndNumericJacobian) {
     Eigen::Matrix2Xd uv;
     std::vector<uint8_t> valid;
     std::vector<Eigen::Matrix<double, 2, 6>> D;
+    std::vector<Eigen::Matrix<double, 2, 3>> E;
     Eigen::Matrix3Xd X_w;
-    tracker.projectReference(0, f.T_new, xi, &uv, &valid, &D, &X_w, w_dot);
+    tracker.projectReference(0, f.T_new, xi, &uv, &valid, &D, &X_w, w_dot, &E);
     std::vector<RsProjection> ref;
     projectRollingShutter(f.camera, timing, RsFrame{f.T_new, xi, w_dot}, X_w, ref);
     int checked = 0;
+    double max_w = 0.0;  // the largest |d uv / d w|: the comparison above is not of zeros
     for (Eigen::Index i = 0; i < uv.cols(); i += 37) {
       const size_t s = static_cast<size_t>(i);
       ASSERT_EQ(static_cast<bool>(valid[s]), ref[s].valid) << "point " << i;
@@ -266,9 +268,25 @@ TEST(FrameTracker, OwnProjectionMatchesRsProjectionAndNumericJacobian) {
           },
           f.T_new, test::leftPlus<SE3d>, 6, 1e-5);
       EXPECT_JACOBIAN_NEAR_TOL(D[s], num, 1e-4, 1e-3);
+      // d uv / d w, the twist's rotation (TrackerOptions::rotation_rate_sigma), checked at its own
+      // scale (about 1 px per rad/s at these rows, zero for a global shutter). The tracker's E takes
+      // exp's left Jacobian over one readout (|w t| < 0.01 rad here) as the identity: 2 % relative.
+      const Eigen::MatrixXd num_w = test::numericJacobian(
+          [&](const Vec3& w) {
+            Vec6 x = xi;
+            x.tail<3>() = w;
+            Eigen::Matrix2Xd q;
+            std::vector<uint8_t> v;
+            tracker.projectReference(0, f.T_new, x, &q, &v, nullptr, nullptr, w_dot);
+            return Vec2(q.col(i));
+          },
+          Vec3(xi.tail<3>()), test::vectorPlus, 3, 1e-4);
+      EXPECT_JACOBIAN_NEAR_TOL(E[s], num_w, 2e-2, 1e-6 + 2e-2 * num_w.norm());
+      max_w = std::max(max_w, num_w.norm());
       ++checked;
     }
     EXPECT_GT(checked, 20);
+    if (timing.dtDv() != 0.0) EXPECT_GT(max_w, 0.5);
   }
 }
 

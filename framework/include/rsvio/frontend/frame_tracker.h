@@ -93,12 +93,15 @@ struct TrackerOptions {
   // Rolling shutter: a tracked frame is tracked again this many times from the pose it reached, with the
   // twist's rotation re-estimated as the rate through that pose (Tracking::track; skipped when the
   // rotation is measured, TrackingFrame::twist_measured). docs/rolling_shutter.md, "Twist refinement".
-  int twist_refinements = 1;
+  int twist_refinements = 0;
   // Rolling shutter: within each guess's coarse-to-fine pass, the twist's rotation is set to
   // TrackingFrame::rotation_rate_of_pose(pose reached) before each solve of the levels below this number
   // (a level DSO repeats too), so they are solved with the rate through the pose found so far (0: the
   // twist stays fixed; 1: before level 0 only).
   int twist_refresh_levels = 0;
+  // Rolling shutter: > 0 estimates the twist's rotation with the pose (its readout shear and stretch are
+  // in the image), under a prior of this sigma [rad/s] about the given twist's; 0 holds the twist fixed.
+  double rotation_rate_sigma = 0.3;
 
   static ParamTable paramTable();                   // keys track_* (see frontend_options.h)
   // Reads the track_* keys; `residual` is left for the caller (ResidualOptions::fromParams).
@@ -129,6 +132,9 @@ struct TrackingFrame {
   int64_t t_ns = 0;
   Vec6 twist = Vec6::Zero();            // kept fixed (prior or previous frame)
   bool twist_measured = false;          // its rotation is the gyroscope's: Tracking does not refine it
+  // Estimate the twist's rotation (TrackerOptions::rotation_rate_sigma > 0): set by Tracking::track with
+  // two frames of history and an unmeasured rotation; the monocular start's frames hold their twists.
+  bool estimate_rotation_rate = false;
   Vec3 w_dot = Vec3::Zero();            // RsFrame::w_dot, kept fixed (the gyroscope's; zero without it)
   // TrackerOptions::twist_refresh_levels: the twist's rotation as a function of the frame's central
   // pose T_c_w (rad/s, camera frame); empty: the twist is held.
@@ -144,6 +150,7 @@ struct TrackResult {
   SE3d T_c_w;                           // central pose of the new frame
   AffineBrightness affine;
   Vec6 twist = Vec6::Zero();            // the twist the result was tracked with (TrackingFrame::twist, or refreshed)
+  bool rate_estimated = false;          // twist's rotation estimated with the pose (TrackingFrame::estimate_rotation_rate)
   double rmse = 0.0;                    // level 0, intensity units
   std::array<double, 6> level_rmse{};   // per level (NaN where not reached)
   double inlier_ratio = 0.0;            // level 0, |r| <= cutoff
@@ -201,10 +208,13 @@ class FrameTracker {
   // The reference points of one level projected into a frame with central pose T_c_w and twist (the
   // tracker's own rolling-shutter solve), with d uv / d T_c_w (left perturbation, row dependence
   // included). Level-0 pixels; X_w (optional) receives the points in the world; w_dot the frame's
-  // RsFrame::w_dot. For tests and diagnostics.
+  // RsFrame::w_dot; d_uv_d_w (optional, with d_uv_d_T) d uv / d (the twist's rotation), the Jacobian
+  // the tracker estimates the rate with (TrackerOptions::rotation_rate_sigma; zero for a global
+  // shutter). For tests and diagnostics.
   void projectReference(int level, const SE3d& T_c_w, const Vec6& twist, Eigen::Matrix2Xd* uv,
                         std::vector<uint8_t>* valid, std::vector<Eigen::Matrix<double, 2, 6>>* d_uv_d_T,
-                        Eigen::Matrix3Xd* X_w = nullptr, const Vec3& w_dot = Vec3::Zero()) const;
+                        Eigen::Matrix3Xd* X_w = nullptr, const Vec3& w_dot = Vec3::Zero(),
+                        std::vector<Eigen::Matrix<double, 2, 3>>* d_uv_d_w = nullptr) const;
 
  private:
   struct LevelPoints;
@@ -212,10 +222,11 @@ class FrameTracker {
   struct Linearization;
   struct Attempt;
 
-  void projectBlock(Block& B, const RsFrame& target, bool linearize) const;
+  // rate: with linearize, also d uv / d w (the twist's rotation) and its blocks of the normal equations.
+  void projectBlock(Block& B, const RsFrame& target, bool linearize, bool rate = false) const;
   void resetRows() const;
   void evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
-                double alpha_ratio, double cutoff, bool linearize, Linearization& out) const;
+                double alpha_ratio, double cutoff, bool linearize, Linearization& out, bool rate = false) const;
   Attempt trackGuess(const ImagePyramid& frame, const TrackingFrame& info, const SE3d& guess,
                      const std::array<double, 6>& abort_rmse) const;
 
