@@ -42,6 +42,10 @@ class Tracking {
   // frames of history, info.twist_measured false), from its pose and with the rotation
   // rotationRateAt(t, that pose): the predicted rotation is the last interval's mean rate, 75 ms old at
   // the frame, and its error turns into pose error (docs/rolling_shutter.md, "Twist refinement").
+  // With the same two conditions and TrackerOptions::rotation_rate_sigma > 0 (the default) the tracker
+  // estimates the twist's rotation with the pose (info.estimate_rotation_rate; TrackResult::twist,
+  // rate_estimated), the refinements' default being 0 (docs/rolling_shutter.md, "The rotation rate
+  // estimated by the tracker").
   TrackResult track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok);
   // Tracks a frame from given guesses; counters and history untouched (frames of the monocular start).
   TrackResult trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses);
