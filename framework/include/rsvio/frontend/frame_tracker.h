@@ -130,7 +130,7 @@ struct TrackingReference {
 // What the tracker needs to know about the new frame besides its image.
 struct TrackingFrame {
   int64_t t_ns = 0;
-  Vec6 twist = Vec6::Zero();            // kept fixed (prior or previous frame)
+  Vec6 twist = Vec6::Zero();            // predicted; held fixed, except its rotation with estimate_rotation_rate (then the prior's mean)
   bool twist_measured = false;          // its rotation is the gyroscope's: Tracking does not refine it
   // Estimate the twist's rotation (TrackerOptions::rotation_rate_sigma > 0): set by Tracking::track with
   // two frames of history and an unmeasured rotation; the monocular start's frames hold their twists.
@@ -149,7 +149,7 @@ struct TrackResult {
   std::string reason;                   // empty when Ok; one line otherwise
   SE3d T_c_w;                           // central pose of the new frame
   AffineBrightness affine;
-  Vec6 twist = Vec6::Zero();            // the twist the result was tracked with (TrackingFrame::twist, or refreshed)
+  Vec6 twist = Vec6::Zero();            // the twist the result was tracked with (TrackingFrame::twist, refreshed, or rate estimated)
   bool rate_estimated = false;          // twist's rotation estimated with the pose (TrackingFrame::estimate_rotation_rate)
   double rmse = 0.0;                    // level 0, intensity units
   std::array<double, 6> level_rmse{};   // per level (NaN where not reached)
