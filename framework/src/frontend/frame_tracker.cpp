@@ -205,6 +205,7 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
   const float sat_energy_unit = huberEnergy(cut, kernel.huber);
   const float warp[4] = {1.f, 0.f, 0.f, 1.f};
   const double explained2 = options_.explained_residual * options_.explained_residual;
+  rate = rate && linearize && timing_.dtDv() != 0.0;  // projectBlock forms E under the same condition
 
   auto runBlock = [&](int bi) {
     Block& B = L.blocks[static_cast<size_t>(bi)];
@@ -278,7 +279,7 @@ void FrameTracker::evaluate(const ImageLevel& img, int level, const RsFrame& tar
       acc.b.head<6>().noalias() += D.transpose() * Vec2(grx, gry);
       acc.b(6) += cr;
       acc.b(7) += r1;
-      if (rate && timing_.dtDv() != 0.0) {
+      if (rate) {
         const Jac23& E = B.E[static_cast<size_t>(i)];
         acc.H.block<6, 3>(0, 8).noalias() += D.transpose() * G * E;
         acc.H.block<1, 3>(6, 8).noalias() += Vec2(gcx, gcy).transpose() * E;

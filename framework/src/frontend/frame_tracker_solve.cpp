@@ -34,6 +34,10 @@ std::string fmt(double v, int prec = 2) {
 
 }  // namespace
 
+bool FrameTracker::estimatesRate(const TrackingFrame& info) const {
+  return info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
+}
+
 FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const TrackingFrame& info,
                                                const SE3d& guess, const std::array<double, 6>& abort_rmse) const {
   Attempt a;
@@ -48,7 +52,7 @@ FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const 
   // Rolling shutter, TrackerOptions::rotation_rate_sigma: the twist's rotation is estimated too, with a
   // prior about the given rate; its weight in the energy's units is the level's mean energy per term
   // at the level's start (the residual variance) over sigma^2, energy sum w r^2 + lambda_w |w - w0|^2.
-  const bool rate = info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
+  const bool rate = estimatesRate(info);
   const Vec3 w_prior = info.twist.tail<3>();
   const double rate_time = 0.5 * std::abs(timing_.dtDv()) * std::max(1.0, 2.0 * timing_.y0);
   for (int lvl = coarsest; lvl >= 0; --lvl) {
@@ -183,7 +187,7 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
   res.T_c_w = best.T_c_w;
   res.affine = best.affine;
   res.twist = best.twist;
-  res.rate_estimated = info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
+  res.rate_estimated = estimatesRate(info);
   res.level_rmse = best.level_rmse;
 
   // Lost tests on the winner, at level 0 with the base cutoff and its twist.

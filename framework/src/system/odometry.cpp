@@ -238,13 +238,15 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   record->addFrame(rec);
   tracking->pushHistory(rec.t_ns, rec.T_c_w, rec.keyframe);
   fillInertial(rec.t_ns);
+  // The frame's twist for the candidate tracer and, if it becomes one, the new keyframe's start: the
+  // frame-to-frame velocity, with the rotation the tracker estimated where it did
+  // (TrackerOptions::rotation_rate_sigma: the rate of this frame, not the mean of the last interval).
+  Vec6 xi_frame = rolling ? tracking->velocityEstimate() : Vec6::Zero();
+  if (rolling && r.rate_estimated) xi_frame.tail<3>() = r.twist.tail<3>();
   {
     ScopedStage st(record->stages(), "trace");
     CandidateFrame target;
-    // The frame-to-frame velocity, with the rotation the tracker estimated where it did
-    // (TrackerOptions::rotation_rate_sigma): the rate of this frame, not the mean of the last interval.
-    target.pose = RsFrame{r.T_c_w, rolling ? tracking->velocityEstimate() : Vec6::Zero()};
-    if (rolling && r.rate_estimated) target.pose.xi.tail<3>() = r.twist.tail<3>();
+    target.pose = RsFrame{r.T_c_w, xi_frame};
     if (imu_twist) inertial->frameTwist(ref, frame.t_ns, r.T_c_w, &target.pose.xi);
     target.pose.w_dot = info.w_dot;
     target.affine = r.affine;
@@ -265,11 +267,8 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
   if (!needKeyframe(bo, cue, &why)) return FrameStatus{true, false, "tracked"};
   {
     ScopedStage st(record->stages(), "keyframe");
-    // A new keyframe's twist starts as the candidate tracer's above.
-    Vec6 xi_start = tracking->velocityEstimate();
-    if (rolling && r.rate_estimated) xi_start.tail<3>() = r.twist.tail<3>();
     makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, std::move(pyr), r.T_c_w, r.affine,
-                 rolling && r.rate_estimated ? &xi_start : nullptr);
+                 rolling && r.rate_estimated ? &xi_frame : nullptr);
   }
   return FrameStatus{true, true, failed ? "failed: " + failure : "keyframe (" + why + ")"};
 }

@@ -225,6 +225,9 @@ class FrameTracker {
   // rate: with linearize, also d uv / d w (the twist's rotation) and its blocks of the normal equations.
   void projectBlock(Block& B, const RsFrame& target, bool linearize, bool rate = false) const;
   void resetRows() const;
+  // Whether this frame's twist rotation is estimated (TrackingFrame::estimate_rotation_rate, a rolling
+  // shutter, TrackerOptions::rotation_rate_sigma > 0).
+  bool estimatesRate(const TrackingFrame& info) const;
   void evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
                 double alpha_ratio, double cutoff, bool linearize, Linearization& out, bool rate = false) const;
   Attempt trackGuess(const ImagePyramid& frame, const TrackingFrame& info, const SE3d& guess,
