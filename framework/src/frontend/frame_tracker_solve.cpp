@@ -38,6 +38,11 @@ bool FrameTracker::estimatesRate(const TrackingFrame& info) const {
   return info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
 }
 
+bool FrameTracker::keptPoorlyExplained(double explained_ratio) const {
+  return options_.explained_keep_fraction > 0.0 && explained_ratio >= options_.min_explained_floor &&
+         explained_ratio >= options_.explained_keep_fraction * last_explained_;  // false while NaN
+}
+
 FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const TrackingFrame& info,
                                                const SE3d& guess, const std::array<double, 6>& abort_rmse) const {
   Attempt a;
@@ -208,15 +213,17 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
                  " (rmse " + fmt(res.rmse) + ")";
   } else if (!(res.rmse <= options_.max_rmse)) {
     res.reason = "rmse " + fmt(res.rmse) + " above " + fmt(options_.max_rmse);
-  } else if (!(res.explained_ratio >= options_.min_explained_ratio)) {
+  } else if (!(res.explained_ratio >= options_.min_explained_ratio) && !keptPoorlyExplained(res.explained_ratio)) {
     res.reason = "explained ratio " + fmt(res.explained_ratio) + " below " + fmt(options_.min_explained_ratio) +
                  " (points in view whose residual RMS is below " + fmt(options_.explained_residual) +
-                 " x their pattern's intensity spread)";
+                 " x their pattern's intensity spread; the last tracked frame's " + fmt(last_explained_) + ")";
   } else if ((options_.estimate_a && std::abs(log_alpha) > options_.max_abs_log_alpha) ||
              (options_.estimate_b && std::abs(best.affine.b) > options_.max_abs_b)) {
     res.reason = "brightness change out of range (log gain " + fmt(log_alpha) + ", b " + fmt(best.affine.b) + ")";
   } else {
     res.status = TrackResult::Status::Ok;
+    res.poorly_explained = !(res.explained_ratio >= options_.min_explained_ratio);
+    last_explained_ = res.explained_ratio;
     last_rmse_ = best.level_rmse;
     if (std::isnan(first_rmse_)) first_rmse_ = best.level_rmse[0];
   }
@@ -267,6 +274,12 @@ ParamTable TrackerOptions::paramTable() {
       paramDouble("track_min_explained_ratio", d.min_explained_ratio, 0.0, 1.0, "",
                   "lower share of the points in view whose residual RMS is below half their pattern's "
                   "intensity spread: tracking lost"),
+      paramDouble("track_explained_keep_fraction", d.explained_keep_fraction, 0.0, 1.0, "",
+                  "a frame below track_min_explained_ratio is kept when its ratio is at least this x the last "
+                  "tracked frame's (a model lacking an effect explains every frame less; a wrong pose drops at "
+                  "once; 0: never kept)"),
+      paramDouble("track_min_explained_floor", d.min_explained_floor, 0.0, 1.0, "",
+                  "no frame with a lower explained ratio is kept (track_explained_keep_fraction)"),
       paramInt("track_twist_retries", d.twist_retries, 0, 5, "",
                "rolling shutter: a frame lost with its predicted twist is tracked again this many times at most, "
                "with the twist's rotation re-estimated from the pose each attempt reached (0: never)"),
@@ -294,6 +307,8 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.min_inlier_ratio = p.getDouble("track_min_inlier_ratio");
   o.max_rmse = p.getDouble("track_max_rmse");
   o.min_explained_ratio = p.getDouble("track_min_explained_ratio");
+  o.explained_keep_fraction = p.getDouble("track_explained_keep_fraction");
+  o.min_explained_floor = p.getDouble("track_min_explained_floor");
   o.twist_retries = static_cast<int>(p.getInt("track_twist_retries"));
   o.twist_refinements = static_cast<int>(p.getInt("track_twist_refinements"));
   o.twist_refresh_levels = static_cast<int>(p.getInt("track_twist_refresh_levels"));

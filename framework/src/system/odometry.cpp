@@ -230,6 +230,7 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
     if (tracking->lostInRow() > bo.max_lost_frames) fail(os.str());
     return FrameStatus{false, false, "tracking lost: " + r.reason};
   }
+  if (r.poorly_explained && poorly_explained_frames++ == 0) first_poorly_explained = frame.index;
   rec.tracked = true;
   rec.T_c_w = r.T_c_w;
   rec.affine = r.affine;
@@ -516,6 +517,15 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
 }
 
 void Odometry::Impl::finish() {
+  if (poorly_explained_frames > 0) {
+    std::ostringstream os;
+    os << poorly_explained_frames << " of " << record->frames().size()
+       << " frames were tracked with an explained ratio below frontend.track_min_explained_ratio (first: frame "
+       << first_poorly_explained
+       << "), kept as they fell gradually: the model explains these images poorly; rsvio diagnose on this run "
+          "looks for the effect it lacks";
+    record->addWarning(os.str());
+  }
   if (!initialized && !failed) {
     // The sequence ended before the monocular start succeeded: nothing was estimated, and saying
     // "ok" would hide it.

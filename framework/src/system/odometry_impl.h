@@ -75,6 +75,10 @@ struct Odometry::Impl {
   bool failed = false;
   std::string failure;
   int64_t vi_init_t_ns = -1;  // the keyframe time of the visual-inertial initialisation
+  // Frames tracked although the model explained them poorly (TrackResult::poorly_explained): a warning
+  // at the end, and a hint for rsvio diagnose.
+  int64_t poorly_explained_frames = 0;
+  int64_t first_poorly_explained = -1;
 
   Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSetup& s);
 

@@ -26,15 +26,19 @@ TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_i
   // Twist retries (rolling shutter, see tracking.h): the lost attempt's pose, rotation-dominated, is
   // mostly right where the predicted twist lagged a sudden change of the rotation rate (its readout
   // shear is then missing from the model); the rate through that pose, extrapolated to the frame's
-  // time, is the better twist, and the pose the better first guess.
-  for (int k = 0; !*ok && timing_.dtDv() != 0.0 && k < twist_retries_; ++k) {
+  // time, is the better twist, and the pose the better first guess. A frame kept although poorly
+  // explained (TrackResult::poorly_explained) is retried the same way; a retry replaces it when it
+  // explains more.
+  for (int k = 0; (!*ok || r.poorly_explained) && timing_.dtDv() != 0.0 && k < twist_retries_; ++k) {
     const SE3d T = r.T_c_w;
     info.twist.tail<3>() = rotationRateAt(info.t_ns, &T);
     std::vector<SE3d> gk{T};
     gk.insert(gk.end(), g.begin(), g.end());
-    r = tracker_->track(pyr, info, gk);
+    TrackResult rk = tracker_->track(pyr, info, gk);
+    if (*ok && !(good(rk) && rk.explained_ratio > r.explained_ratio)) break;
+    if (good(rk)) ++twist_rescues_;
+    r = std::move(rk);
     *ok = good(r);
-    if (*ok) ++twist_rescues_;
   }
   if (!*ok) {
     ++lost_in_row_;

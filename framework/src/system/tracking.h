@@ -37,7 +37,9 @@ class Tracking {
   // Rolling shutter: a frame lost with info.twist is tracked again, at most TrackerOptions::twist_retries
   // times, from the pose the last attempt reached and with the twist's rotation rotationRateAt(t, that
   // pose) (translation kept). A frame whose rotation rate changed suddenly is otherwise lost, as the
-  // fast preset's were within 2 s (docs/rolling_shutter.md, "Twist retries").
+  // fast preset's were within 2 s (docs/rolling_shutter.md, "Twist retries"). A frame the tracker kept
+  // although poorly explained (TrackResult::poorly_explained) is retried the same way, and a retry that
+  // explains more replaces it.
   // A tracked frame is tracked again TrackerOptions::twist_refinements times (rolling shutter, two
   // frames of history, info.twist_measured false), from its pose and with the rotation
   // rotationRateAt(t, that pose): the predicted rotation is the last interval's mean rate, 75 ms old at
@@ -54,7 +56,7 @@ class Tracking {
   void setTiming(const RowTiming& timing);
   void resetFirstRmse() { first_rmse_ = std::nan(""); }
   int lostInRow() const { return lost_in_row_; }
-  long twistRescues() const { return twist_rescues_; }  // frames tracked only by a twist retry
+  long twistRescues() const { return twist_rescues_; }  // frames a twist retry tracked or explained better
   double firstRmse() const { return first_rmse_; }
 
   // Motion history.

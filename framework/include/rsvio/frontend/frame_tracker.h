@@ -25,7 +25,8 @@
 //   (DSO's setting_reTrackThreshold). The best (lowest level-0 RMSE) wins.
 // - Tracking lost: the result says Lost with a reason when no guess leaves enough points in view,
 //   when the winner's inlier ratio (share of pattern pixels with |r| <= cutoff) is below
-//   min_inlier_ratio, its RMSE above max_rmse, its explained ratio below min_explained_ratio, or its
+//   min_inlier_ratio, its RMSE above max_rmse, its explained ratio below min_explained_ratio (unless it
+//   is close to the last tracked frame's: TrackerOptions::explained_keep_fraction), or its
 //   brightness change out of range. A lost result still carries the best pose found; callers must not
 //   use it as a measurement.
 // - Explained ratio: the share of the level-0 points in view whose pattern the pose explains, i.e.
@@ -79,6 +80,13 @@ struct TrackerOptions {
   double max_rmse = 14.0;                           // intensity (sqrt of energy per pattern pixel)
   double min_explained_ratio = 0.25;                // share of the points in view explained (see above)
   double explained_residual = 0.5;                  // per point: residual RMS / its pattern's intensity spread
+  // A winner below min_explained_ratio is kept (TrackResult::poorly_explained) when its ratio is at least
+  // explained_keep_fraction x the last tracked frame's and at least min_explained_floor: a model that lacks
+  // an effect (a rolling shutter tracked as a global one, exposure without affine brightness) explains
+  // each frame a little less than the one before as it moves away from the keyframe, where a wrong pose
+  // drops the ratio at once (docs/frontend.md, "Poorly explained frames"). 0: never kept.
+  double explained_keep_fraction = 0.4;
+  double min_explained_floor = 0.08;
   double max_abs_log_alpha = 1.5;                   // |log(exposure ratio exp(a_j - a_i))| (DSO)
   double max_abs_b = 200.0;                         // intensity
   // Which brightness parameters the tracker estimates (the back end sets these from the photometric
@@ -155,6 +163,7 @@ struct TrackResult {
   std::array<double, 6> level_rmse{};   // per level (NaN where not reached)
   double inlier_ratio = 0.0;            // level 0, |r| <= cutoff
   double explained_ratio = 0.0;         // level 0: share of the points in view explained (contract)
+  bool poorly_explained = false;        // Ok although explained_ratio < min_explained_ratio (TrackerOptions)
   int num_points = 0;                   // points with a residual on level 0
   int guess_index = -1;                 // which guess won
   int guesses_tried = 0;
@@ -228,6 +237,9 @@ class FrameTracker {
   // Whether this frame's twist rotation is estimated (TrackingFrame::estimate_rotation_rate, a rolling
   // shutter, TrackerOptions::rotation_rate_sigma > 0).
   bool estimatesRate(const TrackingFrame& info) const;
+  // Whether a winner with this explained ratio (below min_explained_ratio) is kept: close enough to the
+  // last tracked frame's (TrackerOptions::explained_keep_fraction, min_explained_floor).
+  bool keptPoorlyExplained(double explained_ratio) const;
   void evaluate(const ImageLevel& img, int level, const RsFrame& target, const AffineBrightness& aff,
                 double alpha_ratio, double cutoff, bool linearize, Linearization& out, bool rate = false) const;
   Attempt trackGuess(const ImagePyramid& frame, const TrackingFrame& info, const SE3d& guess,
@@ -240,6 +252,7 @@ class FrameTracker {
   std::vector<std::unique_ptr<LevelPoints>> levels_;
   std::array<double, 6> last_rmse_;
   double first_rmse_ = std::nan("");
+  double last_explained_ = std::nan("");   // explained ratio of the last frame tracked (any reference)
   std::unique_ptr<BlockRunner> runner_;
 };
 
