@@ -38,9 +38,15 @@ bool FrameTracker::estimatesRate(const TrackingFrame& info) const {
   return info.estimate_rotation_rate && options_.rotation_rate_sigma > 0.0 && timing_.dtDv() != 0.0;
 }
 
+namespace {
+constexpr int kRecentFrames = 10;  // TrackerOptions::max_poorly_explained counts over these
+}  // namespace
+
 bool FrameTracker::keptPoorlyExplained(double explained_ratio) const {
+  const int recent = __builtin_popcount(recent_poor_ & ((1u << kRecentFrames) - 1u));
   return options_.explained_keep_fraction > 0.0 && explained_ratio >= options_.min_explained_floor &&
-         explained_ratio >= options_.explained_keep_fraction * last_explained_;  // false while NaN
+         explained_ratio >= options_.explained_keep_fraction * last_explained_ &&  // false while NaN
+         recent < options_.max_poorly_explained;
 }
 
 FrameTracker::Attempt FrameTracker::trackGuess(const ImagePyramid& frame, const TrackingFrame& info,
@@ -224,6 +230,7 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
     res.status = TrackResult::Status::Ok;
     res.poorly_explained = !(res.explained_ratio >= options_.min_explained_ratio);
     last_explained_ = res.explained_ratio;
+    recent_poor_ = (recent_poor_ << 1) | (res.poorly_explained ? 1u : 0u);
     last_rmse_ = best.level_rmse;
     if (std::isnan(first_rmse_)) first_rmse_ = best.level_rmse[0];
   }
@@ -280,6 +287,8 @@ ParamTable TrackerOptions::paramTable() {
                   "once; 0: never kept)"),
       paramDouble("track_min_explained_floor", d.min_explained_floor, 0.0, 1.0, "",
                   "no frame with a lower explained ratio is kept (track_explained_keep_fraction)"),
+      paramInt("track_max_poorly_explained", d.max_poorly_explained, 0, 10, "",
+               "no frame is kept poorly explained when this many of the last 10 tracked frames were"),
       paramInt("track_twist_retries", d.twist_retries, 0, 5, "",
                "rolling shutter: a frame lost with its predicted twist is tracked again this many times at most, "
                "with the twist's rotation re-estimated from the pose each attempt reached (0: never)"),
@@ -309,6 +318,7 @@ TrackerOptions TrackerOptions::fromParams(const Params& p) {
   o.min_explained_ratio = p.getDouble("track_min_explained_ratio");
   o.explained_keep_fraction = p.getDouble("track_explained_keep_fraction");
   o.min_explained_floor = p.getDouble("track_min_explained_floor");
+  o.max_poorly_explained = static_cast<int>(p.getInt("track_max_poorly_explained"));
   o.twist_retries = static_cast<int>(p.getInt("track_twist_retries"));
   o.twist_refinements = static_cast<int>(p.getInt("track_twist_refinements"));
   o.twist_refresh_levels = static_cast<int>(p.getInt("track_twist_refresh_levels"));

@@ -85,8 +85,11 @@ struct TrackerOptions {
   // an effect (a rolling shutter tracked as a global one, exposure without affine brightness) explains
   // each frame a little less than the one before as it moves away from the keyframe, where a wrong pose
   // drops the ratio at once (docs/frontend.md, "Poorly explained frames"). 0: never kept.
+  // A sustained failure is not kept: at most max_poorly_explained of the last 10 tracked frames may be
+  // poorly explained (a run whose state broke at its start fades as gradually, but for longer).
   double explained_keep_fraction = 0.4;
   double min_explained_floor = 0.08;
+  int max_poorly_explained = 4;
   double max_abs_log_alpha = 1.5;                   // |log(exposure ratio exp(a_j - a_i))| (DSO)
   double max_abs_b = 200.0;                         // intensity
   // Which brightness parameters the tracker estimates (the back end sets these from the photometric
@@ -253,6 +256,7 @@ class FrameTracker {
   std::array<double, 6> last_rmse_;
   double first_rmse_ = std::nan("");
   double last_explained_ = std::nan("");   // explained ratio of the last frame tracked (any reference)
+  unsigned recent_poor_ = 0;               // bit i: the i-th last tracked frame was poorly explained
   std::unique_ptr<BlockRunner> runner_;
 };
 
