@@ -89,7 +89,7 @@ struct TrackerOptions {
   // poorly explained (a run whose state broke at its start fades as gradually, but for longer).
   double explained_keep_fraction = 0.4;
   double min_explained_floor = 0.08;
-  int max_poorly_explained = 4;
+  int max_poorly_explained = 6;
   double max_abs_log_alpha = 1.5;                   // |log(exposure ratio exp(a_j - a_i))| (DSO)
   double max_abs_b = 200.0;                         // intensity
   // Which brightness parameters the tracker estimates (the back end sets these from the photometric
