@@ -85,8 +85,8 @@ struct TrackerOptions {
   // an effect (a rolling shutter tracked as a global one, exposure without affine brightness) explains
   // each frame a little less than the one before as it moves away from the keyframe, where a wrong pose
   // drops the ratio at once (docs/frontend.md, "Poorly explained frames"). 0: never kept.
-  // A sustained failure is not kept: at most max_poorly_explained of the last 10 tracked frames may be
-  // poorly explained (a run whose state broke at its start fades as gradually, but for longer).
+  // A sustained failure is not kept: no frame is kept when max_poorly_explained of the last 10 tracked
+  // frames were poorly explained (a run whose state broke at its start fades as gradually, but longer).
   double explained_keep_fraction = 0.4;
   double min_explained_floor = 0.08;
   int max_poorly_explained = 6;
