@@ -647,7 +647,7 @@ nlohmann::json Odometry::shutterReport() const {
   j["line_delay_us"] = m.timing.line_delay_s * 1e6;
   j["readout_ms"] = m.timing.line_delay_s * rows * 1e3;
   if (m.shutter->estimatesLineDelay()) j["line_delay_us_start"] = m.line_delay_start_s * 1e6;
-  j["twist_rescued_frames"] = m.tracking->twistRescues();  // tracked only by a twist retry (tracking.h)
+  j["twist_rescued_frames"] = m.tracking->twistRescues();  // tracked or explained better by a twist retry (tracking.h)
   return j;
 }
 std::vector<std::string> Odometry::warnings() const { return impl_->record->warnings(); }
