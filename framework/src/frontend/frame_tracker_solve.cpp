@@ -42,6 +42,14 @@ namespace {
 constexpr int kRecentFrames = 10;  // TrackerOptions::max_poorly_explained counts over these
 }  // namespace
 
+void FrameTracker::accept(const TrackResult& result) {
+  if (!result.ok()) return;
+  last_explained_ = result.explained_ratio;
+  recent_poor_ = (recent_poor_ << 1) | (result.poorly_explained ? 1u : 0u);
+  last_rmse_ = result.level_rmse;
+  if (std::isnan(first_rmse_)) first_rmse_ = result.level_rmse[0];
+}
+
 bool FrameTracker::keptPoorlyExplained(double explained_ratio) const {
   const int recent = __builtin_popcount(recent_poor_ & ((1u << kRecentFrames) - 1u));
   return options_.explained_keep_fraction > 0.0 && explained_ratio >= options_.min_explained_floor &&
@@ -229,10 +237,6 @@ TrackResult FrameTracker::track(const ImagePyramid& frame, const TrackingFrame& 
   } else {
     res.status = TrackResult::Status::Ok;
     res.poorly_explained = !(res.explained_ratio >= options_.min_explained_ratio);
-    last_explained_ = res.explained_ratio;
-    recent_poor_ = (recent_poor_ << 1) | (res.poorly_explained ? 1u : 0u);
-    last_rmse_ = best.level_rmse;
-    if (std::isnan(first_rmse_)) first_rmse_ = best.level_rmse[0];
   }
 
   // DSO's flow indicators on the level-0 points, central poses.

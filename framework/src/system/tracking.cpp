@@ -58,11 +58,14 @@ TrackResult Tracking::track(const ImagePyramid& pyr, const TrackingFrame& info_i
   }
   lost_in_row_ = 0;
   if (std::isnan(first_rmse_)) first_rmse_ = r.rmse;
+  tracker_->accept(r);  // once, the result kept: retries and refinements above are not frames
   return r;
 }
 
 TrackResult Tracking::trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses) {
-  return tracker_->track(pyr, info, guesses);
+  TrackResult r = tracker_->track(pyr, info, guesses);
+  tracker_->accept(r);  // Ok only
+  return r;
 }
 
 void Tracking::setTiming(const RowTiming& timing) {

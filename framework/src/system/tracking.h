@@ -49,7 +49,8 @@ class Tracking {
   // rate_estimated), the refinements' default being 0 (docs/rolling_shutter.md, "The rotation rate
   // estimated by the tracker").
   TrackResult track(const ImagePyramid& pyr, const TrackingFrame& info, bool* ok);
-  // Tracks a frame from given guesses; counters and history untouched (frames of the monocular start).
+  // Tracks a frame from given guesses (frames of the monocular start): the tracker accepts an Ok result
+  // (FrameTracker::accept); the lost counter and the motion history are untouched.
   TrackResult trackFrom(const ImagePyramid& pyr, const TrackingFrame& info, const std::vector<SE3d>& guesses);
   void setReference(const TrackingReference& reference);
   // A new line delay (estimated online); takes effect with the next setReference().

@@ -164,6 +164,7 @@ TEST(SimTracking, ConstantVelocityGuessesTrackASequence) {
     const TrackResult r =
         tracker.track(*s.pyramid(i), TrackingFrame(), prior.predict(history, s.sim->frameStamps()[i]));
     ASSERT_TRUE(r.ok()) << "frame " << i << ": " << r.reason;
+    tracker.accept(r);
     EXPECT_LT(transErr(r.T_c_w, s.pose(i)), 0.02) << "frame " << i;
     EXPECT_LT(rotErr(r.T_c_w, s.pose(i)), 0.005) << "frame " << i;
     MotionState m;

@@ -91,6 +91,8 @@ TEST(FrameTracker, ConvergesWithinTheStatedBasin) {
     EXPECT_GT(r.inlier_ratio, 0.9);
     EXPECT_LT(r.rmse, 4.0);
     EXPECT_GT(r.flow_rt_px, 1.0);
+    EXPECT_TRUE(std::isnan(tracker.firstRmse()) == (trial == 0));  // set by accept(), not by track()
+    tracker.accept(r);
     EXPECT_TRUE(std::isfinite(tracker.firstRmse()));
   }
 }
@@ -142,6 +144,41 @@ TEST(FrameTracker, TracksWithAThirdOfTheImageOccluded) {
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_LT(transErr(r.T_c_w, f.T_new), 0.005);
   EXPECT_LT(rotErr(r.T_c_w, f.T_new), 0.002);
+}
+
+TEST(FrameTracker, PoorlyExplainedFramesCountOncePerAcceptedFrame) {
+  // With min_explained_ratio out of reach every winner is poorly explained: it is kept only next to an
+  // accepted frame that explained as much (explained_keep_fraction), and only while fewer than
+  // max_poorly_explained of the last 10 accepted frames were poorly explained. track() itself keeps no
+  // memory: a caller that tries a frame several times (Tracking's twist retries) accepts it once.
+  const Fixture& f = fixture();
+  TrackerOptions o;
+  o.min_explained_ratio = 1.5;
+  FrameTracker tracker(o, f.camera, RowTiming::global(f.K.height * 0.5 - 0.5));
+  tracker.setReference(f.ref);
+  const SE3d guess = SE3d::exp(twist(0.01, -0.01, 0.005, 0.003, 0.002, -0.004)) * f.T_new;
+  const TrackResult first = tracker.track(*f.new_pyr, TrackingFrame(), {guess});
+  ASSERT_FALSE(first.ok()) << "no frame accepted yet, nothing to keep it by";
+  EXPECT_NE(first.reason.find("explained ratio"), std::string::npos) << first.reason;
+  TrackResult explained;  // a frame the model explained (as Tracking accepts it)
+  explained.status = TrackResult::Status::Ok;
+  explained.explained_ratio = 0.9;
+  tracker.accept(explained);
+  for (int k = 0; k < 10; ++k) {  // tried again and again, never accepted: kept every time
+    const TrackResult r = tracker.track(*f.new_pyr, TrackingFrame(), {guess});
+    ASSERT_TRUE(r.ok()) << "try " << k << ": " << r.reason;
+    EXPECT_TRUE(r.poorly_explained);
+    EXPECT_GT(r.explained_ratio, 0.4 * 0.9);
+    EXPECT_LT(transErr(r.T_c_w, f.T_new), 0.005);
+  }
+  for (int k = 0; k < o.max_poorly_explained; ++k) {
+    const TrackResult r = tracker.track(*f.new_pyr, TrackingFrame(), {guess});
+    ASSERT_TRUE(r.ok()) << "accepted frame " << k << ": " << r.reason;
+    tracker.accept(r);
+  }
+  const TrackResult last = tracker.track(*f.new_pyr, TrackingFrame(), {guess});
+  EXPECT_FALSE(last.ok()) << o.max_poorly_explained << " of the last 10 accepted frames were poorly explained";
+  EXPECT_NE(last.reason.find("explained ratio"), std::string::npos) << last.reason;
 }
 
 TEST(FrameTracker, RecoveryGuessesRescueABadFirstGuess) {

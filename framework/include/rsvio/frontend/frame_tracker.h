@@ -194,11 +194,17 @@ class FrameTracker {
   int numReferencePoints(int level) const;
 
   // Tracks one frame from the guesses (best first; an empty list means "the keyframe's pose").
+  // track() keeps no memory of its result: the caller accept()s the one result it keeps for a frame.
   TrackResult track(const ImagePyramid& frame, const TrackingFrame& info, const std::vector<SE3d>& guesses);
+  // Commits the result kept for one frame (Ok; ignored otherwise): its RMSE per level (lastRmse(), the
+  // early stop over guesses), firstRmse() and the explained-ratio memory that keeps poorly explained
+  // frames (explained_keep_fraction, max_poorly_explained). Once per frame: retries and refinements
+  // that were tried and dropped must not count as tracked frames.
+  void accept(const TrackResult& result);
 
-  // RMSE per level of the last successful track (DSO's lastCoarseRMSE); NaN before the first.
+  // RMSE per level of the last accepted track (DSO's lastCoarseRMSE); NaN before the first.
   const std::array<double, 6>& lastRmse() const { return last_rmse_; }
-  // Level-0 RMSE of the first successful track since setReference() (DSO's firstCoarseRMSE: a frame
+  // Level-0 RMSE of the first accepted track since setReference() (DSO's firstCoarseRMSE: a frame
   // whose RMSE exceeds twice this calls for a keyframe); NaN until then.
   double firstRmse() const { return first_rmse_; }
 
@@ -255,8 +261,8 @@ class FrameTracker {
   std::vector<std::unique_ptr<LevelPoints>> levels_;
   std::array<double, 6> last_rmse_;
   double first_rmse_ = std::nan("");
-  double last_explained_ = std::nan("");   // explained ratio of the last frame tracked (any reference)
-  unsigned recent_poor_ = 0;               // bit i: the i-th last tracked frame was poorly explained
+  double last_explained_ = std::nan("");   // explained ratio of the last frame accepted (any reference)
+  unsigned recent_poor_ = 0;               // bit i: the i-th last accepted frame was poorly explained
   std::unique_ptr<BlockRunner> runner_;
 };
 
