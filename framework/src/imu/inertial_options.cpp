@@ -72,6 +72,9 @@ ParamTable inertialParamTable() {
                   "refuse an initialisation whose IMU factors at its solution (poses held) have a mean whitened "
                   "energy above this (the keyframe poses do not fit the IMU; tried again at the next keyframe); "
                   "0: no test"),
+      paramInt("init_refusals_warn", d.init_refusals_warn, 0, 1000000, "",
+               "warn when the initialisation succeeded only after this many refused attempts (the start's "
+               "keyframe poses did not fit the IMU: the trajectory before it may be broken); 0: no warning"),
       paramBool("dynamic_marginalization", d.dynamic_marginalization,
                 "dynamic marginalisation for the scale (VI-DSO): the window switches to a second prior holding "
                 "only newer IMU factors and twist energies when the scale leaves the interval around the first's"),
@@ -123,6 +126,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.init_max_accel_bias_m_s2 = p.getDouble("init_max_accel_bias_m_s2");
   o.init_min_interval_s = p.getDouble("init_min_interval_s");
   o.init_max_imu_chi2 = p.getDouble("init_max_imu_chi2");
+  o.init_refusals_warn = static_cast<int>(p.getInt("init_refusals_warn"));
   o.dynamic_marginalization = p.getBool("dynamic_marginalization");
   o.dynamic_marginalization_interval = p.getDouble("dynamic_marginalization_interval");
   o.init_scale_factor = p.getDouble("init_scale_factor");

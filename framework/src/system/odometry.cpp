@@ -517,6 +517,19 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
 }
 
 void Odometry::Impl::finish() {
+  // A late initialisation after many refusals: the start's keyframe poses did not fit the IMU
+  // (InertialOptions::init_refusals_warn). Not a failure: the run after it may be sound.
+  if (inertial && inertial->initialised() && inertial->options().init_refusals_warn > 0 &&
+      inertial->refusals() >= inertial->options().init_refusals_warn) {
+    std::ostringstream os;
+    os << "the visual-inertial initialisation succeeded only at t " << io::formatSeconds(vi_init_t_ns) << " s, after "
+       << inertial->refusals() << " refused attempts since t " << io::formatSeconds(inertial->firstRefusalNs())
+       << " s (imu.init_refusals_warn " << inertial->options().init_refusals_warn << "; first: "
+       << inertial->firstRefusal()
+       << "): the keyframe poses of the run's start did not fit the IMU, and the trajectory before the "
+          "initialisation may be broken";
+    record->addWarning(os.str());
+  }
   if (poorly_explained_frames > 0) {
     std::ostringstream os;
     os << poorly_explained_frames << " of " << record->frames().size()

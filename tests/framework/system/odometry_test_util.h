@@ -54,6 +54,7 @@ struct RunOutcome {
   long keyframes = 0;
   io::Trajectory frame_traj, kf_traj;
   std::vector<std::string> messages;
+  std::vector<std::string> warnings;  // Odometry::warnings() after finish()
   std::map<std::string, double> stage_ms;
   size_t diagnostics_rows = 0;
   double ate_rmse_m = -1.0;     // keyframes, Sim(3), against the dataset's camera ground truth (VO)
@@ -104,6 +105,7 @@ inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& c
   out.diagnostics_rows = odo.diagnostics().observations.size();
   out.vio = odo.inertialReport();
   out.shutter = odo.shutterReport();
+  out.warnings = odo.warnings();
   // Camera ground truth: body poses mapped through the calibration's T_B_C.
   const auto gt_path = io::findDatasetGroundTruth(dataset);
   if (gt_path && out.kf_traj.size() >= 3 && out.kf_traj.frame == io::PoseFrame::kCamera) {

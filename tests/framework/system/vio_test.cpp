@@ -131,6 +131,37 @@ TEST(VisualInertial, RefusedInitialisationsAreCountedWithTheFirstReason) {
   EXPECT_GT(r.vio.at("init_first_refusal_at_s").get<double>(), 0.0);
 }
 
+// A run initialised only after imu.init_refusals_warn refusals ends with a warning that its start may
+// be broken (Table I's seq02 seeds 2-3: 40 and 42 refusals, 830 and 231 mm, reported "ok" without it;
+// the default bound 20 lies above the 0-8 refusals of 55 runs that ended well, docs/vio.md). On tiny_gs
+// the default run is refused twice (the test above): no warning at the default bound, the warning with
+// the bound at its count, none with the bound just above it. Shown once: with the warning's test
+// removed from Odometry::finish this fails.
+TEST(VisualInertial, ALateInitialisationAfterManyRefusalsIsAWarning) {
+  const std::string data = simDataset("tiny_gs");
+  auto refusal_warnings = [](const VioOutcome& r) {
+    int n = 0;
+    for (const std::string& w : r.warnings) n += w.find("refused attempts") != std::string::npos;
+    return n;
+  };
+  const VioOutcome ok = runVio(data, runConfig("gs_vio", {}));
+  ASSERT_TRUE(ok.vio.at("initialised").get<bool>()) << ok.vio.dump();
+  const int refusals = ok.vio.at("init_refusals").get<int>();
+  ASSERT_GT(refusals, 0) << "tiny_gs's default run is no longer refused: this test needs a run that is";
+  EXPECT_EQ(refusal_warnings(ok), 0);
+  const std::string at = "imu.init_refusals_warn=" + std::to_string(refusals);
+  const VioOutcome warned = runVio(data, runConfig("gs_vio", {at}));
+  ASSERT_TRUE(warned.vio.at("initialised").get<bool>());
+  ASSERT_EQ(refusal_warnings(warned), 1) << warned.vio.dump();
+  for (const std::string& w : warned.warnings)
+    if (w.find("refused attempts") != std::string::npos) {
+      EXPECT_NE(w.find(std::to_string(refusals) + " refused attempts"), std::string::npos) << w;
+      EXPECT_NE(w.find("refused: biases"), std::string::npos) << "names the first refusal's reason: " << w;
+    }
+  const VioOutcome above = runVio(data, runConfig("gs_vio", {"imu.init_refusals_warn=" + std::to_string(refusals + 1)}));
+  EXPECT_EQ(refusal_warnings(above), 0);
+}
+
 // An accelerometer that reads 20 m/s^2 too much on x from 2 s on (after the initialisation) cannot be
 // explained by a slowly walking bias: the run fails with an inertial divergence reason.
 TEST(VisualInertial, ABrokenAccelerometerAfterTheStartIsReportedAsDivergence) {
