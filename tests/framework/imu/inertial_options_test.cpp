@@ -40,6 +40,7 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["init_max_accel_bias_m_s2"] = o.init_max_accel_bias_m_s2;
   got["init_min_interval_s"] = o.init_min_interval_s;
   got["init_max_imu_chi2"] = o.init_max_imu_chi2;
+  got["init_refusals_warn"] = o.init_refusals_warn;
   got["dynamic_marginalization"] = o.dynamic_marginalization;
   got["dynamic_marginalization_interval"] = o.dynamic_marginalization_interval;
   got["init_scale_factor"] = o.init_scale_factor;
