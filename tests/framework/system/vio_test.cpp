@@ -133,7 +133,7 @@ TEST(VisualInertial, RefusedInitialisationsAreCountedWithTheFirstReason) {
 
 // A run initialised only after imu.init_refusals_warn refusals ends with a warning that its start may
 // be broken (Table I's seq02 seeds 2-3: 40 and 42 refusals, 830 and 231 mm, reported "ok" without it;
-// the default bound 20 lies above the 0-8 refusals of 55 runs that ended well, docs/vio.md). On tiny_gs
+// the default bound 20 lies above the 0-11 refusals of 56 runs that ended well, docs/vio.md). On tiny_gs
 // the default run is refused twice (the test above): no warning at the default bound, the warning with
 // the bound at its count, none with the bound just above it. Shown once: with the warning's test
 // removed from Odometry::finish this fails.

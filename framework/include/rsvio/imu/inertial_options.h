@@ -89,7 +89,8 @@ struct InertialOptions {
   // A run whose initialisation succeeded only after this many refused attempts (the three tests above)
   // ends with a warning: the keyframe poses of its start did not fit the IMU for that long, and the
   // trajectory before the initialisation may be broken (Table I's seq02 seeds 2-3: 40 and 42 refusals,
-  // 830 and 231 mm; 0-8 in 55 visual-inertial runs that ended well, docs/vio.md). 0: no warning.
+  // 830 and 231 mm; the demo's default model on its hidden rolling shutter: 23, 0.89 m; 0-11 in 56
+  // visual-inertial runs that ended well, docs/vio.md). 0: no warning.
   int init_refusals_warn = 20;
   // Dynamic marginalisation for the scale (backend/dynamic_marginalization.h): a second prior with only
   // the scale-dependent terms since the scale entered its current half-interval, switched in when the
