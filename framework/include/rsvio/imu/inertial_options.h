@@ -86,8 +86,8 @@ struct InertialOptions {
   // the IMU (the rolling-shutter monocular start's distorted first keyframes, docs/vio.md); tried again
   // at the next keyframe. 0: no test.
   double init_max_imu_chi2 = 0.0;
-  // A run whose initialisation succeeded only after this many refused attempts (the three tests above)
-  // ends with a warning: the keyframe poses of its start did not fit the IMU for that long, and the
+  // A run whose initialisation succeeded only after this many refused attempts (a solution rejected, or
+  // refused by one of the three bounds above: InertialState::noteRefusal) ends with a warning: the keyframe poses of its start did not fit the IMU for that long, and the
   // trajectory before the initialisation may be broken (Table I's seq02 seeds 2-3: 40 and 42 refusals,
   // 830 and 231 mm; the demo's default model on its hidden rolling shutter: 23, 0.89 m; 0-11 in 56
   // visual-inertial runs that ended well, docs/vio.md). 0: no warning.
