@@ -223,6 +223,7 @@ void MonoInitializer::reset(int64_t frame_index, int64_t t_ns) {
   cv::goodFeaturesToTrack(img8, corners, options_.init_corners, 0.01, std::max(3.0, diag / 60.0), mask, 5);
   ref_pts_ = corners;
   cur_pts_ = corners;
+  unexplained_flow_.assign(corners.size(), Vec2::Zero());
   hist_pts_.assign(1, corners);
   hist_t_ns_.assign(1, t_ns);
   initial_tracks_ = static_cast<int>(corners.size());
@@ -239,18 +240,44 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
     status_ = "reference frame set (" + std::to_string(initial_tracks_) + " corners)";
     return false;
   }
+  // Where each search starts: the corner's old position, or (with a rotation source) its bearing
+  // rotated by the camera's rotation since the previous frame and projected back, plus what the
+  // rotation did not explain of the corner's previous step (translation's flow, constant over one frame
+  // interval; 0 on a new reference). The old position where the projection fails.
+  const size_t n = cur_pts_.size();
+  Eigen::Matrix2Xd rotated_px(2, static_cast<Eigen::Index>(n));
+  for (size_t i = 0; i < n; ++i) rotated_px.col(static_cast<Eigen::Index>(i)) = Vec2(cur_pts_[i].x, cur_pts_[i].y);
+  Eigen::Matrix2Xd guess = rotated_px;
+  SO3d R_cur_prev;
+  const bool rotated = guess_source_ && n > 0 && guess_source_(hist_t_ns_.back(), t_ns, &R_cur_prev);
+  if (rotated) {
+    Eigen::Matrix3Xd bearing;
+    std::vector<uint8_t> ok_u, ok_p;
+    camera_.unproject(guess, bearing, ok_u);
+    Eigen::Matrix2Xd uv;
+    camera_.project(R_cur_prev.matrix() * bearing, uv, ok_p);
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Index c = static_cast<Eigen::Index>(i);
+      if (!ok_u[i] || !ok_p[i] || !uv.col(c).allFinite()) continue;
+      rotated_px.col(c) = uv.col(c);
+      guess.col(c) = uv.col(c) + unexplained_flow_[i];
+    }
+  }
   // Frame-to-frame tracks with a forward-backward check.
   std::vector<cv::Point2f> ref_kept, cur_kept;
   std::vector<size_t> kept;
-  for (size_t i = 0; i < cur_pts_.size(); ++i) {
+  std::vector<Vec2> unexplained_kept;
+  for (size_t i = 0; i < n; ++i) {
     const Vec2 p(cur_pts_[i].x, cur_pts_[i].y);
     Vec2 q, back;
-    if (!trackPoint(*prev_, *pyramid, p, p, &q)) continue;
+    if (!trackPoint(*prev_, *pyramid, p, guess.col(static_cast<Eigen::Index>(i)), &q)) continue;
     if (!trackPoint(*pyramid, *prev_, q, p, &back) || (back - p).norm() > 1.0) continue;
     ref_kept.push_back(ref_pts_[i]);
     cur_kept.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
     kept.push_back(i);
+    unexplained_kept.push_back(rotated ? Vec2(q - rotated_px.col(static_cast<Eigen::Index>(i))) : Vec2::Zero());
   }
+  unexplained_flow_.swap(unexplained_kept);
   ref_pts_.swap(ref_kept);
   cur_pts_.swap(cur_kept);
   for (std::vector<cv::Point2f>& h : hist_pts_) {
@@ -269,7 +296,7 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
     return false;
   }
   if (frames_since_ref_ < options_.init_min_frames) {
-    status_ = "waiting for frames";
+    status_ = "waiting for frames (" + std::to_string(cur_pts_.size()) + " corner tracks)";
     return false;
   }
   return tryInitialise();

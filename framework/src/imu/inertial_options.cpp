@@ -35,6 +35,9 @@ ParamTable inertialParamTable() {
       paramBool("init_rates_from_gyro", d.init_rates_from_gyro,
                 "rolling shutter: the monocular start's rotation rate of each image from the gyroscope at its time "
                 "(gyro bias 0) instead of from the corner tracks (backend.init_rotation_rates)"),
+      paramBool("init_track_guess_from_gyro", d.init_track_guess_from_gyro,
+                "the monocular start's corner tracks start each search where the gyroscope's rotation since the "
+                "previous frame moves the corner (gyro bias 0) instead of where it was"),
       paramBool("readout_angular_acceleration", d.readout_angular_acceleration,
                 "rolling shutter: the rows' rotation to second order in the row time, with the twist rotation's rate of "
                 "change from the gyroscope (known, not optimised)"),
@@ -114,6 +117,7 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.gyro_bias_sigma_before_init_rad_s = p.getDouble("gyro_bias_sigma_before_init_rad_s");
   o.frame_rotation_from_gyro_before_init = p.getBool("frame_rotation_from_gyro_before_init");
   o.init_rates_from_gyro = p.getBool("init_rates_from_gyro");
+  o.init_track_guess_from_gyro = p.getBool("init_track_guess_from_gyro");
   o.readout_angular_acceleration = p.getBool("readout_angular_acceleration");
   o.twist_gyro_sigma_before_init_rad_s = p.getDouble("twist_gyro_sigma_before_init_rad_s");
   o.smooth_motion_rot_weight_before_init = p.getDouble("smooth_motion_rot_weight_before_init");

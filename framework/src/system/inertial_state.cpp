@@ -354,4 +354,20 @@ bool InertialState::gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const
   return true;
 }
 
+bool InertialState::gyroRotation(int64_t t0_ns, int64_t t1_ns, const Vec3& bias_gyro, SO3d* R_1_0) const {
+  const int64_t off = offsetNs();
+  if (t1_ns < t0_ns || !buffer_.covers(t0_ns + off, t1_ns + off)) return false;
+  constexpr int64_t kStep = 5'000'000;
+  const int64_t steps = std::max<int64_t>(1, (t1_ns - t0_ns + kStep - 1) / kStep);
+  SO3d R;
+  for (int64_t k = 0; k < steps; ++k) {
+    const int64_t a = t0_ns + (t1_ns - t0_ns) * k / steps, b = t0_ns + (t1_ns - t0_ns) * (k + 1) / steps;
+    Vec3 w;
+    if (!gyroRate(a + (b - a) / 2, bias_gyro, &w)) return false;
+    R = SO3d::exp(w * (1e-9 * static_cast<double>(b - a))) * R;
+  }
+  *R_1_0 = R;
+  return true;
+}
+
 }  // namespace rsvio

@@ -85,6 +85,11 @@ class InertialState {
   // left of T_Cf_Wf: -R_Cm_I (gyro - b_g), rad/s) with the gyro bias b_g given. Needs no scale or
   // gravity, so it serves before the initialisation. False without an IMU sample around t_ns + offset.
   bool gyroRate(int64_t t_ns, const Vec3& bias_gyro, Vec3* w) const;
+  // The camera's rotation from camera time t0_ns to t1_ns by the gyroscope (bias b_g given): camera
+  // coordinates of a static point at t1 are R_1_0 times those at t0 (the rates of gyroRate integrated
+  // at their midpoints over steps of at most 5 ms, the newest step on the left). False without IMU
+  // samples over the span.
+  bool gyroRotation(int64_t t0_ns, int64_t t1_ns, const Vec3& bias_gyro, SO3d* R_1_0) const;
   // Rolling shutter with options().readout_angular_acceleration: RsFrame::w_dot at camera time t_ns, the
   // rate of change of gyroRate (central difference over +-10 ms, the bias cancels). Zero otherwise or
   // without IMU samples over that span.

@@ -52,6 +52,9 @@ class MonoStart {
   const Vec6& xiCur() const { return initializer_.xiCur(); }
   const std::string& status() const { return initializer_.status(); }
   void setRateSource(MonoInitializer::RateSource source) { initializer_.setRateSource(std::move(source)); }
+  void setTrackGuessSource(MonoInitializer::RotationSource source) {
+    initializer_.setTrackGuessSource(std::move(source));
+  }
   void clear() { frames_.clear(); }
 
  private:

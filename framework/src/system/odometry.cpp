@@ -121,6 +121,12 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
       const InertialState* in = inertial.get();
       start->setRateSource([in](int64_t t_ns, Vec3* w) { return in->gyroRate(t_ns, Vec3::Zero(), w); });
     }
+    if (io.init_track_guess_from_gyro) {
+      const InertialState* in = inertial.get();
+      start->setTrackGuessSource([in](int64_t t0_ns, int64_t t1_ns, SO3d* R) {
+        return in->gyroRotation(t0_ns, t1_ns, Vec3::Zero(), R);
+      });
+    }
     record->setGlobals(&window->globals());
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");

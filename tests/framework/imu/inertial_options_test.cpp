@@ -28,6 +28,7 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["gyro_bias_sigma_before_init_rad_s"] = o.gyro_bias_sigma_before_init_rad_s;
   got["frame_rotation_from_gyro_before_init"] = o.frame_rotation_from_gyro_before_init;
   got["init_rates_from_gyro"] = o.init_rates_from_gyro;
+  got["init_track_guess_from_gyro"] = o.init_track_guess_from_gyro;
   got["readout_angular_acceleration"] = o.readout_angular_acceleration;
   got["twist_gyro_sigma_before_init_rad_s"] = o.twist_gyro_sigma_before_init_rad_s;
   got["smooth_motion_rot_weight_before_init"] = o.smooth_motion_rot_weight_before_init;

@@ -40,6 +40,13 @@ struct InertialOptions {
   // at the image's time (gyro bias 0) instead of fitted from the corner tracks
   // (backend.init_rotation_rates, MonoInitializer::setRateSource); the two keyframes start with them.
   bool init_rates_from_gyro = false;
+  // The monocular start's corner tracks (either shutter): each corner's Lucas-Kanade search starts
+  // where the gyroscope's rotation since the previous frame moves it (gyro bias 0), plus the flow the
+  // rotation left unexplained in the corner's previous step, instead of where it was
+  // (MonoInitializer::setTrackGuessSource; VINS-Mono predicts its feature tracks with the IMU rotation).
+  // Off by default: it keeps the tracks through seq02's 73 deg/s, but the earlier start it allows was
+  // better on some runs and worse on others (docs/vio.md, "Gyroscope-rotated corner guesses").
+  bool init_track_guess_from_gyro = false;
   // Rolling shutter: the rows' rotation to second order in the row time, with the rate of change of the
   // twist's rotation from the gyroscope (RsFrame::w_dot, geometry/rs_projection.h): each keyframe's and
   // each tracked frame's w_dot = -R_Cm_I d omega / dt at its time (central difference of the gyroscope
