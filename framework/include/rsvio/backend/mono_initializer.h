@@ -43,11 +43,13 @@
 //   (setRateSource: the gyroscope in a visual-inertial run, imu.init_rates_from_gyro) the rates are
 //   the source's at each image's timestamp, from the first frame after the reference on.
 // - Corner guesses (setTrackGuessSource: the gyroscope in a visual-inertial run,
-//   imu.init_track_guess_from_gyro): each corner's Lucas-Kanade search starts at its bearing rotated by
-//   the camera's rotation since the previous frame (translation neglected; each row's own time is not
-//   used: the guess only has to fall in the search's basin) instead of at its old position. At seq02's
-//   73 deg/s a corner moves about 30 px per frame, and the zero-motion guess kept about a quarter of the
-//   corners per frame (docs/vio.md, "Gyroscope-rotated corner guesses").
+//   imu.init_track_guess_from_gyro, off by default): each corner's Lucas-Kanade search starts at its
+//   bearing rotated by the camera's rotation since the previous frame, plus the flow that the rotation
+//   left unexplained in the corner's previous step (the translation's, taken as constant over a frame
+//   interval; each row's own time is not used: the guess only has to fall in the search's basin),
+//   instead of at its old position. At seq02's 73 deg/s a corner moves 30-70 px per frame over
+//   repetitive texture, and the zero-motion guess kept about a quarter of the corners per frame
+//   (docs/vio.md, "Gyroscope-rotated corner guesses").
 #pragma once
 #include <cstdint>
 #include <functional>
