@@ -17,15 +17,10 @@ namespace {
 class CornerGuessTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    CameraCalibration c = defaultContractCalibration();
-    c.width = 320;
-    c.height = 256;
-    c.intrinsics = Eigen::Vector4d(250.0, 250.0, 159.5, 127.5);
-    c.distortion = "none";
-    c.distortion_coeffs = Eigen::VectorXd();
+    const CameraCalibration c = defaultContractCalibration();  // 320x256 pinhole, f 250 px, no distortion
     cam_ = makePlugin<CameraModel>("camera.pinhole");
     cam_->setCalibration(c);
-    K_ << 250.0, 0.0, 159.5, 0.0, 250.0, 127.5, 0.0, 0.0, 1.0;
+    K_ << c.intrinsics[0], 0.0, c.intrinsics[2], 0.0, c.intrinsics[1], c.intrinsics[3], 0.0, 0.0, 1.0;
     R_ = SO3d::exp(Vec3(0.03, 0.16, 0.02));  // about 40 px of flow, mostly along the rows
     // A wall of shelves: books as vertical bars of random width and grey, each with its own top edge.
     canvas_ = cv::Mat(256 + 2 * kMargin, 320 + 2 * kMargin, CV_32F, cv::Scalar(90.0f));
