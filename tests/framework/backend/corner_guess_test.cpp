@@ -1,7 +1,7 @@
 // The monocular start's corner tracks through a fast turn (MonoInitializer::setTrackGuessSource,
-// rsvio/backend/mono_initializer.h): two images of a book-shelf-like texture (vertical bars 2-6 px wide,
-// the repetition that makes Lucas-Kanade slip by a bar) related by a pure camera rotation, which moves
-// every corner by about 40 px. Convention: camera coordinates at the second image are R_1_0 times those
+// rsvio/backend/mono_initializer.h): images of a book-shelf-like texture (vertical bars 2-6 px wide,
+// the repetition that makes Lucas-Kanade slip by a bar) related by a camera rotation that moves every
+// corner by about 40 px per frame (and, in the last test, a sideways flow the rotation does not explain). Convention: camera coordinates at the second image are R_1_0 times those
 // at the first (left form, as the gyroscope's source gives it), so pixels map by K R_1_0 K^-1.
 #include <gtest/gtest.h>
 
@@ -35,12 +35,15 @@ class CornerGuessTest : public ::testing::Test {
     cv::GaussianBlur(canvas_, canvas_, cv::Size(3, 3), 0.7);
   }
 
-  // The image of a camera rotated by R from the first (the first image: R = identity).
-  std::shared_ptr<const ImagePyramid> image(const SO3d& R) const {
-    // Destination pixel x1 -> source x0 = K R^-1 K^-1 x1, then into the canvas (offset kMargin).
-    Eigen::Matrix3d T = Eigen::Matrix3d::Identity();
+  // The image of a camera rotated by R from the first (the first image: R = identity), every pixel
+  // then moved by shift_px (what a translation parallel to a wall does).
+  std::shared_ptr<const ImagePyramid> image(const SO3d& R, const Vec2& shift_px = Vec2::Zero()) const {
+    // Destination pixel x1 -> source x0 = K R^-1 K^-1 (x1 - shift), then into the canvas (offset kMargin).
+    Eigen::Matrix3d T = Eigen::Matrix3d::Identity(), S = Eigen::Matrix3d::Identity();
     T(0, 2) = T(1, 2) = kMargin;
-    const Eigen::Matrix3d M = T * K_ * R.inverse().matrix() * K_.inverse();
+    S(0, 2) = -shift_px.x();
+    S(1, 2) = -shift_px.y();
+    const Eigen::Matrix3d M = T * K_ * R.inverse().matrix() * K_.inverse() * S;
     cv::Mat Mcv(3, 3, CV_64F);
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) Mcv.at<double>(r, c) = M(r, c);
@@ -91,6 +94,30 @@ TEST_F(CornerGuessTest, WithoutTheRotationTheSameTurnLosesMostTracks) {
   int initial = 0;
   const int kept = tracksKept(false, &initial);
   EXPECT_LT(kept, 0.5 * initial) << kept << " of " << initial;
+}
+
+// Two steps of the same turn and a 12 px sideways flow each (a translation parallel to the wall) that
+// the gyroscope does not see: the first step's search starts 12 px off, the second's starts where the
+// first step's unexplained flow says. Measured: 140 of the 174 tracks of the first step kept in the
+// second; 118 with that flow left out of the guess (the turn carries about 15 % out of the image
+// either way).
+TEST_F(CornerGuessTest, TheFlowTheRotationLeftUnexplainedCarriesToTheNextFrame) {
+  BackendOptions o;
+  o.init_min_frames = 10;
+  MonoInitializer init(o, *cam_, RowTiming::global(0.0));
+  init.setTrackGuessSource([this](int64_t t0, int64_t t1, SO3d* R) {
+    if (t1 - t0 != 50'000'000) return false;
+    *R = R_;
+    return true;
+  });
+  const Vec2 step(12.0, 0.0);
+  init.addFrame(image(SO3d()), 0, 0);
+  init.addFrame(image(R_, step), 1, 50'000'000);
+  ASSERT_NE(init.status().find("waiting for frames"), std::string::npos) << init.status();
+  const int n1 = init.numTracks();
+  init.addFrame(image(R_ * R_, 2.0 * step), 2, 100'000'000);
+  ASSERT_NE(init.status().find("waiting for frames"), std::string::npos) << init.status();
+  EXPECT_GE(init.numTracks(), 0.74 * n1) << init.numTracks() << " of " << n1;
 }
 
 }  // namespace
