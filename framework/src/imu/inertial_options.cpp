@@ -37,7 +37,8 @@ ParamTable inertialParamTable() {
                 "(gyro bias 0) instead of from the corner tracks (backend.init_rotation_rates)"),
       paramBool("init_track_guess_from_gyro", d.init_track_guess_from_gyro,
                 "the monocular start's corner tracks start each search where the gyroscope's rotation since the "
-                "previous frame moves the corner (gyro bias 0) instead of where it was"),
+                "previous frame moves the corner (gyro bias 0), plus the flow the rotation left unexplained in the "
+                "corner's previous step, instead of where it was"),
       paramBool("readout_angular_acceleration", d.readout_angular_acceleration,
                 "rolling shutter: the rows' rotation to second order in the row time, with the twist rotation's rate of "
                 "change from the gyroscope (known, not optimised)"),
