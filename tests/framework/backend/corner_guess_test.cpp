@@ -1,8 +1,9 @@
 // The monocular start's corner tracks through a fast turn (MonoInitializer::setTrackGuessSource,
 // rsvio/backend/mono_initializer.h): images of a book-shelf-like texture (vertical bars 2-6 px wide,
 // the repetition that makes Lucas-Kanade slip by a bar) related by a camera rotation that moves every
-// corner by about 40 px per frame (and, in the last test, a sideways flow the rotation does not explain). Convention: camera coordinates at the second image are R_1_0 times those
-// at the first (left form, as the gyroscope's source gives it), so pixels map by K R_1_0 K^-1.
+// corner by about 40 px per frame (and, in the last test, a sideways flow the rotation does not
+// explain). Convention: camera coordinates at the later image are R_1_0 times those at the earlier
+// (left form, as the gyroscope's source gives it), so pixels map by K R_1_0 K^-1.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -53,17 +54,24 @@ class CornerGuessTest : public ::testing::Test {
     return std::make_shared<ImagePyramid>(out, 5);
   }
 
-  // Tracks of the first image's corners that survive into the second; the initial count in *initial.
-  int tracksKept(bool with_source, int* initial) const {
+  // A start that only tracks (no attempt at a pose); with_source: its guesses turn by R_ per 50 ms.
+  std::unique_ptr<MonoInitializer> start(bool with_source) const {
     BackendOptions o;
-    o.init_min_frames = 10;  // no attempt at a pose: only the tracks are looked at
-    MonoInitializer init(o, *cam_, RowTiming::global(0.0));
+    o.init_min_frames = 10;
+    auto init = std::make_unique<MonoInitializer>(o, *cam_, RowTiming::global(0.0));
     if (with_source)
-      init.setTrackGuessSource([this](int64_t t0, int64_t t1, SO3d* R) {
-        if (t0 != 0 || t1 != 50'000'000) return false;
+      init->setTrackGuessSource([this](int64_t t0, int64_t t1, SO3d* R) {
+        if (t1 - t0 != 50'000'000) return false;
         *R = R_;
         return true;
       });
+    return init;
+  }
+
+  // Tracks of the first image's corners that survive into the second; the initial count in *initial.
+  int tracksKept(bool with_source, int* initial) const {
+    const std::unique_ptr<MonoInitializer> owner = start(with_source);
+    MonoInitializer& init = *owner;
     init.addFrame(image(SO3d()), 0, 0);
     *initial = init.numTracks();
     init.addFrame(image(R_), 1, 50'000'000);
@@ -102,14 +110,8 @@ TEST_F(CornerGuessTest, WithoutTheRotationTheSameTurnLosesMostTracks) {
 // second; 118 with that flow left out of the guess (the turn carries about 15 % out of the image
 // either way).
 TEST_F(CornerGuessTest, TheFlowTheRotationLeftUnexplainedCarriesToTheNextFrame) {
-  BackendOptions o;
-  o.init_min_frames = 10;
-  MonoInitializer init(o, *cam_, RowTiming::global(0.0));
-  init.setTrackGuessSource([this](int64_t t0, int64_t t1, SO3d* R) {
-    if (t1 - t0 != 50'000'000) return false;
-    *R = R_;
-    return true;
-  });
+  const std::unique_ptr<MonoInitializer> owner = start(true);
+  MonoInitializer& init = *owner;
   const Vec2 step(12.0, 0.0);
   init.addFrame(image(SO3d()), 0, 0);
   init.addFrame(image(R_, step), 1, 50'000'000);
