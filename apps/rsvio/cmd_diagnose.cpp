@@ -318,6 +318,9 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
                  {"pairs", pairs.size()},
                  {"span_s", usable ? 1e-9 * static_cast<double>(t1 - t0) : 0.0},
                  {"imu_rows", run.log.imu.size()}};
+    std::map<std::pair<int32_t, int32_t>, int> steps;  // the monocular start's corner steps (track rows)
+    for (const auto& t : run.log.tracks) steps[{t.frame, t.prev_frame}] = 1;
+    d["data"]["start_corner_steps"] = steps.size();
     d["data"]["trajectory_poses"] = run.trajectory ? run.trajectory->poses.size() : 0;
     d["data"]["dataset_imu_samples"] = run.dataset && run.dataset->sensors().has_imu ? run.dataset->imu().size() : 0;
     if (!run.dataset_note.empty()) d["data"]["dataset_note"] = run.dataset_note;
@@ -436,7 +439,10 @@ std::string formatDiagnosis(const nlohmann::json& d) {
   o << "\n";
   if (rs.contains("error")) o << "  (failed: " << rs["error"].get<std::string>() << ")\n";
   o << "data: " << data["usable_observations"] << " residuals of " << data["target_keyframes"] << " keyframes in "
-    << data["pairs"] << " frame pairs over " << fmt(data["span_s"].get<double>()) << " s\n";
+    << data["pairs"] << " frame pairs over " << fmt(data["span_s"].get<double>()) << " s";
+  if (data.value("start_corner_steps", 0) > 0)
+    o << "; the monocular start's corners in " << data["start_corner_steps"] << " frame steps";
+  o << "\n";
   o << "  effect            statistic  threshold    score  plugin\n";
   for (const auto& e : d["ranking"]) {
     char line[256];

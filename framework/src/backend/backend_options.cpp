@@ -89,6 +89,9 @@ ParamTable backendParamTable() {
                "(0: the start ignores the readout)"),
       paramBool("init_keyframe_twist", d.init_keyframe_twist,
                 "rolling shutter: the first keyframe starts with the two-view start's twist (else 0)"),
+      paramDouble("init_affine_min_change", d.init_affine_min_change, 0.0, 100.0, "",
+                  "with affine brightness estimated: the second keyframe starts with the gain of the start's corners "
+                  "against the first when it differs from 1 by more than this (else a = b = 0; 0: always)"),
       paramBool("init_rotation_rates", d.init_rotation_rates,
                 "rolling shutter: the two-view start rotates each image's corners to its central pose with the "
                 "image's own rotation rate, measured from its neighbour frames, and the first two keyframes "
@@ -145,6 +148,7 @@ BackendOptions BackendOptions::fromParams(const Params& p) {
   o.init_corners = static_cast<int>(p.getInt("init_corners"));
   o.init_rolling_shutter_iterations = static_cast<int>(p.getInt("init_rolling_shutter_iterations"));
   o.init_keyframe_twist = p.getBool("init_keyframe_twist");
+  o.init_affine_min_change = p.getDouble("init_affine_min_change");
   o.init_rotation_rates = p.getBool("init_rotation_rates");
   o.max_lost_frames = static_cast<int>(p.getInt("max_lost_frames"));
   o.fail_max_rmse = p.getDouble("fail_max_rmse");

@@ -6,6 +6,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
@@ -15,6 +16,18 @@
 
 namespace rsvio {
 namespace {
+
+// Mean intensity of the 3x3 pixels around p (level 0, bilinear); false near the border.
+bool boxMean(const ImageLevel& level, const Vec2& p, float* mean) {
+  const float u = static_cast<float>(p.x()), v = static_cast<float>(p.y());
+  if (!level.inside(u, v, 2.f)) return false;
+  float sum = 0.f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) sum += level.sampleIntensity(u + static_cast<float>(dx), v + static_cast<float>(dy));
+  *mean = sum / 9.f;
+  return std::isfinite(*mean);
+}
+
 
 constexpr int kHalfWin = 4;       // 9x9 Lucas-Kanade window
 constexpr int kLkIterations = 12;
@@ -223,6 +236,8 @@ void MonoInitializer::reset(int64_t frame_index, int64_t t_ns) {
   cv::goodFeaturesToTrack(img8, corners, options_.init_corners, 0.01, std::max(3.0, diag / 60.0), mask, 5);
   ref_pts_ = corners;
   cur_pts_ = corners;
+  ref_intensity_.assign(corners.size(), std::numeric_limits<float>::quiet_NaN());
+  for (size_t i = 0; i < corners.size(); ++i) boxMean(l0, Vec2(corners[i].x, corners[i].y), &ref_intensity_[i]);
   unexplained_flow_.assign(corners.size(), Vec2::Zero());
   hist_pts_.assign(1, corners);
   hist_t_ns_.assign(1, t_ns);
@@ -234,7 +249,10 @@ void MonoInitializer::reset(int64_t frame_index, int64_t t_ns) {
 
 bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int64_t frame_index, int64_t t_ns) {
   cur_t_ns_ = t_ns;
+  steps_.clear();
+  step_from_ = -1;
   if (!prev_ || ref_index_ < 0) {
+    prev_index_ = frame_index;
     prev_ = std::move(pyramid);
     reset(frame_index, t_ns);
     status_ = "reference frame set (" + std::to_string(initial_tracks_) + " corners)";
@@ -265,6 +283,7 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
   }
   // Frame-to-frame tracks with a forward-backward check.
   std::vector<cv::Point2f> ref_kept, cur_kept;
+  std::vector<float> ref_intensity_kept;
   std::vector<size_t> kept;
   std::vector<Vec2> unexplained_kept;
   for (size_t i = 0; i < n; ++i) {
@@ -273,12 +292,22 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
     if (!trackPoint(*prev_, *pyramid, p, guess.col(static_cast<Eigen::Index>(i)), &q)) continue;
     if (!trackPoint(*pyramid, *prev_, q, p, &back) || (back - p).norm() > 1.0) continue;
     ref_kept.push_back(ref_pts_[i]);
+    ref_intensity_kept.push_back(ref_intensity_[i]);
     cur_kept.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
     kept.push_back(i);
     unexplained_kept.push_back(rotated ? Vec2(q - rotated_px.col(static_cast<Eigen::Index>(i))) : Vec2::Zero());
+    CornerStep s;
+    if (frames_since_ref_ > 0 && boxMean(prev_->level(0), p, &s.intensity_prev) &&
+        boxMean(pyramid->level(0), q, &s.intensity)) {
+      s.px = q;
+      steps_.push_back(s);
+    }
   }
+  if (frames_since_ref_ > 0) step_from_ = prev_index_;
+  prev_index_ = frame_index;
   unexplained_flow_.swap(unexplained_kept);
   ref_pts_.swap(ref_kept);
+  ref_intensity_.swap(ref_intensity_kept);
   cur_pts_.swap(cur_kept);
   for (std::vector<cv::Point2f>& h : hist_pts_) {
     std::vector<cv::Point2f> hk;
@@ -300,6 +329,20 @@ bool MonoInitializer::addFrame(std::shared_ptr<const ImagePyramid> pyramid, int6
     return false;
   }
   return tryInitialise();
+}
+
+double MonoInitializer::logGainCurRef() const {
+  if (!prev_) return 0.0;
+  std::vector<double> ratio;
+  for (size_t i = 0; i < cur_pts_.size(); ++i) {
+    float cur = 0.f;
+    if (std::isfinite(ref_intensity_[i]) && ref_intensity_[i] >= 8.f &&
+        boxMean(prev_->level(0), Vec2(cur_pts_[i].x, cur_pts_[i].y), &cur) && cur > 0.f)
+      ratio.push_back(static_cast<double>(cur) / ref_intensity_[i]);
+  }
+  if (ratio.size() < 20) return 0.0;
+  std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
+  return std::log(ratio[ratio.size() / 2]);
 }
 
 bool MonoInitializer::tryInitialise() {

@@ -116,7 +116,7 @@ class OutputStreams {
   void closeDiagnostics() {
     take();
     if (!diag_) return;
-    guarded("diagnostics.bin", [&] { diag_->close(odo_.diagnostics().imu); });
+    guarded("diagnostics.bin", [&] { diag_->close(odo_.diagnostics().imu, odo_.diagnostics().tracks); });
     diag_.reset();
   }
 

@@ -51,6 +51,7 @@ class MonoStart {
   const Vec6& xiRef() const { return initializer_.xiRef(); }
   const Vec6& xiCur() const { return initializer_.xiCur(); }
   const std::string& status() const { return initializer_.status(); }
+  const MonoInitializer& initializer() const { return initializer_; }
   void setRateSource(MonoInitializer::RateSource source) { initializer_.setRateSource(std::move(source)); }
   void setTrackGuessSource(MonoInitializer::RotationSource source) {
     initializer_.setTrackGuessSource(std::move(source));

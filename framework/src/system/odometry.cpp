@@ -425,6 +425,8 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
     ScopedStage st(record->stages(), "initialise");
     done = start->addFrame(frame, pyr, working);
   }
+  const MonoInitializer& mi = start->initializer();
+  if (!mi.lastSteps().empty()) record->addTrackRows(frame.index, frame.t_ns, mi.lastStepFrom(), mi.lastSteps());
   FrameRecord rec;
   rec.index = frame.index;
   rec.t_ns = frame.t_ns;
@@ -471,7 +473,20 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
     r->ref_kf_id = k0.kf_id;
   }
   window->createCandidates(k0);
+  // The current frame's brightness against keyframe 0 (which has a = b = 0): with affine brightness
+  // estimated, the gain of the start's corners (mono_initializer.h, logGainCurRef) less the known
+  // exposure ratio, as a gain only (b = 0), when it is further from 1 than
+  // backend.init_affine_min_change (backend_options.h: where the trace below would lose the
+  // candidates); the trace and the frame tracking search within a few grey levels of it. Else 0 (DSO's
+  // coarse initialiser estimates the pair's affine brightness jointly with the depths).
+  AffineBrightness affine1;
+  if (estimate_affine) {
+    double a = start->initializer().logGainCurRef();
+    if (ref.exposure_ms > 0.0 && frame.exposure_ms > 0.0) a -= std::log(frame.exposure_ms / ref.exposure_ms);
+    if (std::abs(std::exp(a) - 1.0) > bo.init_affine_min_change) affine1.a = a;
+  }
   CandidateFrame target;
+  target.affine = affine1;
   // The current frame's twist: its own (init_rotation_rates), else the two-view twist, or 0.
   target.pose = RsFrame{T_cur_ref, own_twists ? start->xiCur() : k0.state.twist};
   if (rolling && inertial) target.pose.w_dot = inertial->readoutWDot(frame.t_ns);
@@ -487,8 +502,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   record->addFrame(rec);
   tracking->pushHistory(rec.t_ns, rec.T_c_w, rec.keyframe);
   const Vec6 xi_cur = start->xiCur();
-  makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, pyr, T_cur_ref, AffineBrightness(),
-               own_twists ? &xi_cur : nullptr);
+  makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, pyr, T_cur_ref, affine1, own_twists ? &xi_cur : nullptr);
   initialized = true;
   if (failed) return FrameStatus{false, true, "failed: " + failure};
 
@@ -505,6 +519,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
     info.exposure_ms = f.exposure_ms;
     if (rolling && inertial) info.w_dot = inertial->readoutWDot(f.t_ns);
     const double s = span > 0 ? nsToS(f.t_ns - ref.t_ns) / span : 0.5;
+    info.affine_guess.a = s * affine1.a;  // between keyframe 0's (0) and keyframe 1's start, by time
     const TrackResult r = tracking->trackFrom(p, info, {SE3d::exp(log_rel * s)});
     if (!r.ok()) continue;
     if (FrameRecord* fr = record->frame(f.index)) {

@@ -47,6 +47,21 @@ void RunRecord::takeObservations(std::vector<ObservationRow>* rows) {
   diag_.observations.clear();
 }
 
+void RunRecord::addTrackRows(int64_t index, int64_t t_ns, int64_t from,
+                             const std::vector<MonoInitializer::CornerStep>& steps) {
+  for (const auto& s : steps) {
+    TrackRow t;
+    t.t_ns = t_ns;
+    t.frame = static_cast<int32_t>(index);
+    t.prev_frame = static_cast<int32_t>(from);
+    t.u = static_cast<float>(s.px.x());
+    t.v = static_cast<float>(s.px.y());
+    t.intensity_prev = s.intensity_prev;
+    t.intensity = s.intensity;
+    diag_.tracks.push_back(t);
+  }
+}
+
 void RunRecord::takePoints(std::vector<MapPoint>* points) {
   if (metric_) toMetric(&map_points_);
   if (points->empty()) {

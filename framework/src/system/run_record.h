@@ -9,7 +9,8 @@
 //   marginalised keyframe its final one);
 // - the map points that left the window (those not yet taken out), the diagnostics log (one row per inlier observation when it
 //   leaves the window, io/diagnostics_log.h; only those made since the last takeObservations() when a
-//   run loop streams them out), the stage times and the run's warnings.
+//   run loop streams them out; the monocular start's corner steps as track rows), the stage times and
+//   the run's warnings.
 //
 // Invariants
 // - Frame indices are unique (sequence positions). Records are only appended, except that a frame's
@@ -28,6 +29,7 @@
 #include <vector>
 
 #include "keyframe_window.h"
+#include "rsvio/backend/mono_initializer.h"
 #include "rsvio/interfaces/camera.h"
 #include "rsvio/io/diagnostics_log.h"
 #include "rsvio/io/states.h"
@@ -103,8 +105,10 @@ class RunRecord : public WindowSink {
   void addWarning(const std::string& w) { warnings_.push_back(w); }
   const std::vector<std::string>& warnings() const { return warnings_; }
   const DiagnosticsLog& diagnostics() const { return diag_; }
-  // Moves the observation rows out (appended to *rows); the log keeps its header fields and IMU rows.
+  // Moves the observation rows out (appended to *rows); the log keeps its header fields, IMU and track rows.
   void takeObservations(std::vector<ObservationRow>* rows);
+  // The monocular start's corner step into frame `index` (t_ns) from frame `from` (TrackRow).
+  void addTrackRows(int64_t index, int64_t t_ns, int64_t from, const std::vector<MonoInitializer::CornerStep>& steps);
   // A photometric model estimated online (PhotometricModel::estimatesOnline): every observation row
   // is also kept here until the back end hands them over (Odometry::Impl::refinePhotometric).
   void keepRowsForPhotometric(bool on) { keep_photometric_ = on; }

@@ -378,6 +378,7 @@ TEST(BackendOptions, EveryTableKeyIsRead) {
   got["init_corners"] = o.init_corners;
   got["init_rolling_shutter_iterations"] = o.init_rolling_shutter_iterations;
   got["init_keyframe_twist"] = o.init_keyframe_twist;
+  got["init_affine_min_change"] = o.init_affine_min_change;
   got["init_rotation_rates"] = o.init_rotation_rates;
   got["max_lost_frames"] = o.max_lost_frames;
   got["fail_max_rmse"] = o.fail_max_rmse;

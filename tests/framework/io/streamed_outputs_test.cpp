@@ -49,6 +49,15 @@ DiagnosticsLog sampleLog(int n) {
   im.t_j_ns = 9;
   im.whitened[3] = 1.5f;
   log.imu.push_back(im);
+  for (int i = 0; i < 3; ++i) {
+    TrackRow t;
+    t.t_ns = 100 + i;
+    t.frame = i + 1;
+    t.prev_frame = i;
+    t.intensity_prev = 10.f * i;
+    t.intensity = 10.f * i + 0.5f;
+    log.tracks.push_back(t);
+  }
   return log;
 }
 
@@ -70,7 +79,7 @@ TEST(DiagnosticsWriter, StreamedRowsGiveTheBytesOfTheWholeLog) {
     EXPECT_EQ(w.numObservations(), 1000u);
     EXPECT_FALSE(fs::exists(streamed)) << "the final name appears only at close()";
     EXPECT_TRUE(fs::exists(io::atomicTempPath(streamed)));
-    w.close(log.imu);
+    w.close(log.imu, log.tracks);
   }
   EXPECT_FALSE(fs::exists(io::atomicTempPath(streamed)));
   EXPECT_EQ(bytes(streamed), bytes(whole));
@@ -79,6 +88,31 @@ TEST(DiagnosticsWriter, StreamedRowsGiveTheBytesOfTheWholeLog) {
   EXPECT_FLOAT_EQ(back.observations[999].residual, -499.5f);
   ASSERT_EQ(back.imu.size(), 1u);
   EXPECT_FLOAT_EQ(back.imu[0].whitened[3], 1.5f);
+  ASSERT_EQ(back.tracks.size(), 3u);
+  EXPECT_EQ(back.tracks[2].prev_frame, 2);
+  EXPECT_FLOAT_EQ(back.tracks[2].intensity, 20.5f);
+  fs::remove_all(dir);
+}
+
+// A version-2 log (before the track rows) is still read: the version-3 file without its track header
+// and rows, and the version field set to 2.
+TEST(DiagnosticsLog, AVersionTwoFileIsReadWithoutTrackRows) {
+  const std::string dir = tmpDir("version2");
+  DiagnosticsLog log = sampleLog(20);
+  log.write(dir + "/v3.bin");
+  std::string b = bytes(dir + "/v3.bin");
+  const size_t track_head = 16, track_rows = 3 * sizeof(TrackRow);
+  const size_t head = b.size() - track_head - 20 * sizeof(ObservationRow) - sizeof(ImuRow) - track_rows;
+  std::string v2 = b.substr(0, head) + b.substr(head + track_head, b.size() - head - track_head - track_rows);
+  v2[8] = 2;
+  std::ofstream(dir + "/v2.bin", std::ios::binary) << v2;
+  const DiagnosticsLog back = DiagnosticsLog::read(dir + "/v2.bin");
+  EXPECT_EQ(back.observations.size(), 20u);
+  EXPECT_EQ(back.imu.size(), 1u);
+  EXPECT_TRUE(back.tracks.empty());
+  v2[8] = 1;
+  std::ofstream(dir + "/v1.bin", std::ios::binary) << v2;
+  EXPECT_THROW(DiagnosticsLog::read(dir + "/v1.bin"), DataError);
   fs::remove_all(dir);
 }
 

@@ -188,6 +188,43 @@ TEST(Probes, AModelledEffectIsNotApplicable) {
   EXPECT_FALSE(test::makePlugin<DiagnosticProbe>("probe.rolling_shutter")->evaluate(ProbeInput{l2, kGlobalNoAffine}).applicable);
 }
 
+// A run that failed in its first window: 4 observation rows, and the monocular start's corner steps
+// over 11 frames (200 corners each, 3x3 means with noise of 3 grey levels, 5 % slipped tracks far off).
+// step_gain: the brightness ratio of each frame to the previous one.
+DiagnosticsLog startOnlyLog(double step_gain, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  DiagnosticsLog log = syntheticLog(Effect::None, seed);
+  log.observations.resize(4);
+  for (int f = 1; f <= 11; ++f)
+    for (int k = 0; k < 200; ++k) {
+      TrackRow t;
+      t.t_ns = 1000000000LL + f * 50000000LL;
+      t.frame = f;
+      t.prev_frame = f - 1;
+      t.u = static_cast<float>(10 + 300 * U(rng));
+      t.v = static_cast<float>(10 + 236 * U(rng));
+      const double I = 20 + 210 * U(rng);
+      t.intensity_prev = static_cast<float>(I + noise(rng));
+      t.intensity = static_cast<float>(U(rng) < 0.05 ? 255 * U(rng) : step_gain * I + noise(rng));
+      log.tracks.push_back(t);
+    }
+  return log;
+}
+
+TEST(Probes, TheStartsCornerStepsShowAnExposureChangeWhenTheWindowFailed) {
+  const auto probe = test::makePlugin<DiagnosticProbe>("probe.exposure");
+  const ProbeResult changed = probe->evaluate(ProbeInput{startOnlyLog(1.025, 5), kGlobalNoAffine});
+  EXPECT_GT(changed.score, 1.0) << changed.explanation;
+  EXPECT_EQ(changed.details.value("start_pairs", 0), 11) << changed.explanation;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const ProbeResult clean = probe->evaluate(ProbeInput{startOnlyLog(1.0, seed), kGlobalNoAffine});
+    EXPECT_LT(clean.score, 1.0) << "seed " << seed << ": " << clean.explanation;
+    EXPECT_EQ(clean.details.value("start_pairs", 0), 11) << clean.explanation;
+  }
+}
+
 TEST(Probes, AnEmptyLogIsTooLittleDataNotAVerdict) {
   DiagnosticsLog log;
   log.width = 320;

@@ -60,6 +60,11 @@ struct BackendOptions {
   int init_corners = 400;             // corners tracked with pyramidal Lucas-Kanade
   int init_rolling_shutter_iterations = 0;  // two-view rounds with the corners at their row times (mono_initializer.h)
   bool init_keyframe_twist = false;   // rolling shutter: keyframe 0 starts with the two-view twist
+  // Affine brightness estimated: keyframe 1 starts with the start corners' gain g against keyframe 0
+  // (mono_initializer.h, logGainCurRef) when |g - 1| exceeds this. 0.1: a uniform change of 10 % at
+  // mid-grey (13 grey levels) reaches the candidates' trace's outlier energy (DSO's 12^2 per pixel,
+  // Huber 9, slack 1.2); below it the trace copes and the guess would only perturb the start.
+  double init_affine_min_change = 0.1;
   bool init_rotation_rates = true;    // rolling shutter: each start image's rotation rate from its
                                       // neighbour frames (mono_initializer.h); the keyframes start with it
   // Divergence detection (the run ends "failed" with the reason).

@@ -50,6 +50,19 @@
 //   instead of at its old position. At seq02's 73 deg/s a corner moves 30-70 px per frame over
 //   repetitive texture, and the zero-motion guess kept about a quarter of the corners per frame
 //   (docs/vio.md, "Gyroscope-rotated corner guesses").
+// - Brightness of the tracked corners (lastSteps()): each frame-to-frame step keeps, per surviving
+//   track, the mean working-image intensity of the 3x3 pixels around the corner in the previous and
+//   in the current frame (level 0, bilinear). The run writes them to its diagnostics log (TrackRow),
+//   so that probe.exposure sees how brightness changed over the first frames even when the run fails
+//   before its first window (an exposure change the model lacks can make it fail there). The step
+//   out of a reference frame is not kept: there the corners sit where the detector put them (whole
+//   pixels, on the corner's apex), and their 3x3 means differed from those of the tracked positions by
+//   up to 2 % on clean 640x512 sequences (0.1-0.7 % for later steps).
+// - Brightness from the reference to the current frame (logGainCurRef()): the median ratio of the
+//   tracks' 3x3 means in the current frame to those in the reference. A run that estimates affine
+//   brightness starts the second keyframe (and the candidates' trace into it) with it: the trace's
+//   search does not model brightness beyond its affine guess, and over a 0.5 s start the exposure can
+//   change by a third (docs/diagnose.md, "Exposure from the start's corners").
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -141,6 +154,22 @@ class MonoInitializer {
   void setTrackGuessSource(RotationSource source) { guess_source_ = std::move(source); }
   const std::string& status() const { return status_; }  // one line: what the last attempt found
   int numTracks() const { return static_cast<int>(cur_pts_.size()); }
+  // The last addFrame's step: per track kept, its pixel in the current frame (working image) and the
+  // 3x3 mean intensity there and at its position in the previous frame. Empty after a first frame, for
+  // the step out of a reference frame and where no track was kept; lastStepFrom() is the previous
+  // frame's index (-1 then).
+  struct CornerStep {
+    Vec2 px = Vec2::Zero();
+    float intensity_prev = 0.f, intensity = 0.f;
+  };
+  const std::vector<CornerStep>& lastSteps() const { return steps_; }
+  // log(median over the tracks of intensity in the current frame / intensity in the reference), 3x3
+  // means (tracks with a reference intensity of at least 8 grey levels); 0 with fewer than 20 such
+  // tracks. Lucas-Kanade assumes constant brightness, so corners drift a little along their gradients
+  // under a gain and the ratio shows part of the change (3.7 % of 5 % in
+  // tests/framework/backend/corner_guess_test.cpp); the bundle adjustment estimates the rest.
+  double logGainCurRef() const;
+  int64_t lastStepFrom() const { return step_from_; }
 
  private:
   void reset(int64_t frame_index, int64_t t_ns);
@@ -157,12 +186,15 @@ class MonoInitializer {
   int initial_tracks_ = 0;
   std::shared_ptr<const ImagePyramid> prev_;
   std::vector<cv::Point2f> ref_pts_, cur_pts_;
+  std::vector<float> ref_intensity_;  // each track's 3x3 mean in the reference (NaN near the border)
   // With a rotation source: each track's flow in its last step that the rotation did not explain.
   std::vector<Vec2> unexplained_flow_;
   // Every frame's positions of the surviving tracks since the reference (hist_pts_[0] = ref_pts_,
   // back() = cur_pts_) and their timestamps, for the rotation rates.
   std::vector<std::vector<cv::Point2f>> hist_pts_;
   std::vector<int64_t> hist_t_ns_;
+  std::vector<CornerStep> steps_;
+  int64_t prev_index_ = -1, step_from_ = -1;
   RateSource rate_source_;
   RotationSource guess_source_;
   SE3d T_cur_ref_;

@@ -2,7 +2,8 @@
 //
 // One ObservationRow per point observation at its final linearisation (when the observation leaves the
 // window: marginalised or at the end of the run; an outlier when the window drops it, with weight 0),
-// one ImuRow per IMU factor (keyframe pair).
+// one ImuRow per IMU factor (keyframe pair), and (version 3) one TrackRow per corner of the monocular
+// start per frame-to-frame step (backend/mono_initializer.h, lastSteps()).
 // Fields (float32 unless stated):
 //   t_ns (int64)          capture time of the target frame's row y0, camera clock
 //   frame, host (int32)   target and host frame indices (sequence positions)
@@ -15,8 +16,13 @@
 //   vel_u, vel_v          pixel velocity in the target [px/s] from the frame's twist (d uv/dt)
 //   residual, weight      mean pattern residual and its robust weight (0: an outlier)
 //   exposure_ratio        exp(a_target - a_host) when affine brightness is estimated, else 1
+// TrackRow fields: t_ns (int64, the frame's timestamp), frame and prev_frame (int32, the step's two
+// frames), u, v (the corner in the frame, working image), intensity_prev and intensity (3x3 mean of the
+// working image around the corner in prev_frame and in frame).
 // File layout: magic "RSVIODG1", uint32 version, uint32 sizeof(ObservationRow), uint32 sizeof(ImuRow),
-// uint64 n_obs, uint64 n_imu, then the rows, little-endian as on x86-64 / aarch64.
+// int32 width, int32 height, float64 line delay, uint64 n_obs, uint64 n_imu; version 3 then adds uint32
+// sizeof(TrackRow), uint32 0, uint64 n_track; then the observation, IMU and track rows, little-endian
+// as on x86-64 / aarch64. Version 2 files (no track rows) are read too.
 #pragma once
 #include <array>
 #include <cstddef>
@@ -57,6 +63,14 @@ struct ImuRow {
   std::array<float, 15> residual{};    // rotation, velocity, position, bias gyro, bias accel (eqs. 16-19)
   std::array<float, 15> whitened{};    // residual times the square-root information
 };
+struct TrackRow {
+  int64_t t_ns = 0;
+  int32_t frame = 0;
+  int32_t prev_frame = 0;
+  float u = 0, v = 0;
+  float intensity_prev = 0;
+  float intensity = 0;
+};
 #pragma pack(pop)
 
 struct DiagnosticsLog {
@@ -65,6 +79,7 @@ struct DiagnosticsLog {
   double line_delay_s = 0.0;           // as modelled by the run (0: global shutter)
   std::vector<ObservationRow> observations;
   std::vector<ImuRow> imu;
+  std::vector<TrackRow> tracks;        // the monocular start's corner steps (empty in version 2 files)
 
   void write(const std::string& path) const;               // throws Error on I/O failure (DiagnosticsWriter)
   static DiagnosticsLog read(const std::string& path);     // throws DataError on a bad file
@@ -72,7 +87,7 @@ struct DiagnosticsLog {
 
 // Writes a diagnostics log while it is made, so a long run need not hold its rows (issue 16): the
 // observation rows go to the atomic temporary of `path` (io/atomic_file.h, "<path>.tmp-<pid>") as they
-// are appended; close() adds the IMU rows and the header's row counts, then renames the temporary to
+// are appended; close() adds the IMU and track rows and the header's row counts, then renames the temporary to
 // `path`. The file is the one DiagnosticsLog::write gives for the same rows, byte for byte.
 // - Until close() succeeds, `path` is not touched: a process killed at any moment leaves at most the
 //   temporary (rsvio run removes such temporaries of an earlier run), never a truncated `path`.
@@ -88,8 +103,8 @@ class DiagnosticsWriter {
 
   void append(const ObservationRow* rows, size_t n);  // throws Error on I/O failure
   void append(const std::vector<ObservationRow>& rows) { append(rows.data(), rows.size()); }
-  // The IMU rows, the counts, then the rename; throws Error on I/O failure. Once only.
-  void close(const std::vector<ImuRow>& imu);
+  // The IMU and track rows, the counts, then the rename; throws Error on I/O failure. Once only.
+  void close(const std::vector<ImuRow>& imu, const std::vector<TrackRow>& tracks);
   uint64_t numObservations() const { return n_obs_; }
 
  private:
