@@ -28,7 +28,6 @@ bool boxMean(const ImageLevel& level, const Vec2& p, float* mean) {
   return std::isfinite(*mean);
 }
 
-
 constexpr int kHalfWin = 4;       // 9x9 Lucas-Kanade window
 constexpr int kLkIterations = 12;
 constexpr int kRansacIterations = 400;
