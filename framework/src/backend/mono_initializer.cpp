@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "rsvio/core/time.h"
 #include "rsvio/interfaces/camera.h"
@@ -339,9 +340,7 @@ double MonoInitializer::logGainCurRef() const {
         boxMean(prev_->level(0), Vec2(cur_pts_[i].x, cur_pts_[i].y), &cur) && cur > 0.f)
       ratio.push_back(static_cast<double>(cur) / ref_intensity_[i]);
   }
-  if (ratio.size() < 20) return 0.0;
-  std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
-  return std::log(ratio[ratio.size() / 2]);
+  return ratio.size() < 20 ? 0.0 : std::log(median(std::move(ratio)));
 }
 
 bool MonoInitializer::tryInitialise() {
