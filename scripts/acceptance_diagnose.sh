@@ -66,8 +66,10 @@ ate_of() {
   field "$1" "('%.4f' % d['eval']['ate_rmse_m'] if 'eval' in d else 'n/a') + ('' if d['status'] == 'ok' else ' F%d' % d['frames'])"
 }
 
-printf "%-16s %4s %-16s %-44s %12s %12s %8s %s\n" effect seed verdict "top: statistic / threshold (score)" \
-  "ATE before" "ATE after" ratio "evidence" | tee "$TABLE"
+# "ratio": whole-run ATE before / after (unequal spans when a run failed); "same span": the same ratio
+# over the frames both runs tracked, with the before-run's pose count in that span (diagnose --against).
+printf "%-16s %4s %-16s %-44s %12s %12s %8s %14s %s\n" effect seed verdict "top: statistic / threshold (score)" \
+  "ATE before" "ATE after" ratio "same span" "evidence" | tee "$TABLE"
 
 # One case: run the model, diagnose, add the named line, run again, compare (diagnose --against), and
 # repeat while the verdict names an effect (at most 3 rounds: two hidden effects need two), one table
@@ -89,7 +91,7 @@ one() {
   # shellcheck disable=SC2086
   "$BIN" run --config "$(model "$effect")" --data "$data" --out "$run" $sets > "$d/before.log" 2>&1 || true
   for round in 1 2 3; do
-    local diag="$d/diagnose$round.json" verdict line top ate_b ate_a="-" ratio="-" ev="-" next="$d/after$round"
+    local diag="$d/diagnose$round.json" verdict line top ate_b ate_a="-" ratio="-" span="-" ev="-" next="$d/after$round"
     [ "$round" = 1 ] && diag="$d/diagnose.json" && next="$d/after"
     "$BIN" diagnose --run "$run" --json > "$diag" 2> "${diag%.json}.err" || true
     verdict=$(field "$diag" "d['verdict']")
@@ -103,11 +105,13 @@ one() {
       "$BIN" diagnose --run "$next" --against "$run" --json > "$next/against.json" 2>/dev/null || true
       ate_a=$(ate_of "$next/report.json")
       ratio=$(field "$next/against.json" "'%.2f' % d['against']['ate_ratio'] if 'ate_ratio' in d['against'] else '-'")
+      span=$(field "$next/against.json" "(lambda c: '%.2f (%d)' % (c['ate_ratio'], c['frames_before']) if 'ate_ratio' in c else '-')(d['against'].get('common_span', {}))")
       ev=$(field "$next/against.json" "('gone' if d['against']['evidence_gone'] else 'still there') if 'evidence_gone' in d['against'] else '-'")
     fi
     local label="$seed"
     [ "$round" != 1 ] && label="$seed.$round"
-    printf "%-16s %4s %-16s %-44s %12s %12s %8s %s\n" "$effect" "$label" "$verdict" "$top" "$ate_b" "$ate_a" "$ratio" "$ev" | tee -a "$TABLE"
+    printf "%-16s %4s %-16s %-44s %12s %12s %8s %14s %s\n" "$effect" "$label" "$verdict" "$top" "$ate_b" "$ate_a" "$ratio" "$span" \
+      "$ev" | tee -a "$TABLE"
     [ "$verdict" = none ] && break
     [ "$round" -ge "$(rounds "$effect")" ] && break
     run="$next"

@@ -22,8 +22,6 @@
 #include "run_summary.h"
 #include "rsvio/core/error.h"
 #include "rsvio/core/time.h"
-#include "rsvio/eval/evaluate_files.h"
-#include "rsvio/io/trajectory.h"
 #include "rsvio/pipeline/run.h"
 #include "rsvio/plugin/host.h"
 #include "rsvio/sim/simulator.h"
@@ -122,41 +120,22 @@ std::string ateText(const Report& rep) {
 }
 
 // When the default model is lost part way, its ATE covers only the frames it tracked and the run with
-// the named line covers the whole sequence: not comparable. Both are evaluated again over the span the
-// first one tracked (its first to last trajectory stamp), Sim(3)-aligned alike (the first run may have
-// stayed visual, without metric scale), from the trajectory.tum each wrote. The cut trajectory is
-// written to <out>/<after>_over_<before>_span.tum. Returns "" when there is nothing to say.
-std::string commonSpanText(const std::string& data, const std::string& before_dir, const std::string& after_dir,
-                           const std::string& out) {
-  const fs::path tb = fs::path(before_dir) / "trajectory.tum", ta = fs::path(after_dir) / "trajectory.tum";
-  if (!fs::exists(tb) || !fs::exists(ta)) return "";
-  try {
-    const io::Trajectory before = io::readTum(tb.string());
-    io::Trajectory after = io::readTum(ta.string());
-    if (before.size() < 3 || after.size() <= before.size()) return "";
-    const int64_t t0 = before.poses.front().t_ns, t1 = before.poses.back().t_ns;
-    std::vector<io::StampedPose> cut;
-    for (const auto& p : after.poses)
-      if (p.t_ns >= t0 && p.t_ns <= t1) cut.push_back(p);
-    after.poses = cut;
-    const fs::path cut_path = fs::path(out) / (fs::path(after_dir).filename().string() + "_over_" +
-                                               fs::path(before_dir).filename().string() + "_span.tum");
-    io::writeTum(cut_path.string(), after);
-    auto ate = [&](const std::string& est) {
-      eval::FileEvalRequest q;
-      q.dataset_dir = data;
-      q.est_path = est;
-      q.align = eval::AlignMode::kSim3;
-      return eval::evaluateFiles(q).result.ate_m.rmse;
-    };
-    const double a_b = ate(tb.string()), a_a = ate(cut_path.string());
-    char b[256];
-    std::snprintf(b, sizeof b, "ATE over the span the default model tracked (%zu poses, %.2f s, Sim(3)): before %.4f m, after %.4f m",
-                  before.size(), nsToS(t1 - t0), a_b, a_a);
-    return b;
-  } catch (const std::exception& e) {
-    return std::string("ATE over the common span: not computed (") + e.what() + ")";
-  }
+// the named line covers the whole sequence: not comparable. `diagnose --against` also evaluates both
+// over the frames both tracked (its "common_span"); the demo prints that line. Returns "" when the first
+// run was not lost (nothing to add) or the comparison has nothing.
+std::string commonSpanText(const nlohmann::json& cmp) {
+  if (!cmp.contains("against") || !cmp["against"].contains("common_span")) return "";
+  const auto& c = cmp["against"];
+  if (c["before"].value("status", "") == "ok") return "";
+  const auto& s = c["common_span"];
+  if (s.contains("note")) return "ATE over the common span: not computed (" + s["note"].get<std::string>() + ")";
+  std::string align = s["align"].get<std::string>();
+  align = align == "sim3" ? "Sim(3)" : align == "se3" ? "SE(3)" : align;
+  char b[256];
+  std::snprintf(b, sizeof b, "ATE over the span the default model tracked (%d poses, %.2f s, %s): before %.4f m, after %.4f m",
+                s["frames_before"].get<int>(), s["to_s"].get<double>() - s["from_s"].get<double>(), align.c_str(),
+                s["ate_before_m"].get<double>(), s["ate_after_m"].get<double>());
+  return b;
 }
 
 int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
@@ -224,7 +203,7 @@ int runDemo(const std::string& out, bool fresh, const GlobalOptions& g) {
   std::printf("ATE before (default model): %s\n", ateText(rb).c_str());
   if (ran_after) {
     std::printf("ATE after  (with the line): %s\n", ateText(after.report).c_str());
-    const std::string common = commonSpanText(data, before_dir, after_dir, out);
+    const std::string common = commonSpanText(cmp);
     if (!common.empty()) std::printf("%s\n", common.c_str());
     if (cmp.contains("against") && cmp["against"].contains("evidence_gone"))
       std::printf("evidence of %s after the change: %s\n", verdict.c_str(),

@@ -21,6 +21,8 @@
 #include "diagnose.h"
 #include "rsvio/config/config.h"
 #include "rsvio/core/error.h"
+#include "rsvio/eval/alignment.h"
+#include "rsvio/eval/evaluate_files.h"
 #include "rsvio/interfaces/data_source.h"
 #include "rsvio/interfaces/diagnostic_probe.h"
 #include "rsvio/io/diagnostics_log.h"
@@ -146,6 +148,63 @@ nlohmann::json runSummary(const nlohmann::json& report) {
   if (report.is_object() && report.contains("keyframes")) j["keyframes"] = report["keyframes"];
   const double ate = ateOf(report);
   if (std::isfinite(ate)) j["ate_rmse_m"] = ate;
+  return j;
+}
+
+// The two runs' error over the same frames: trajectory.tum (every tracked frame) of each evaluated
+// against the dataset's ground truth over the stamps from the later first pose to the earlier last pose,
+// both with one alignment: the reports' when they agree, else Sim(3) (a run that stayed visual has no
+// metric scale; the whole-run ATEs keep the scale error of a metric run). When
+// one run failed early, the whole-run ATEs compare unequal spans (a short piece of trajectory aligned
+// on its own is small); this compares like with like. Evaluation only: the verdict never reads it.
+// Returns {"note": why} when it cannot be made (no trajectory, different datasets, no ground truth).
+nlohmann::json commonSpanComparison(const std::string& before_dir, const LoadedRun& before, const std::string& after_dir,
+                                    const LoadedRun& after) {
+  auto note = [](const std::string& why) { return nlohmann::json{{"note", why}}; };
+  if (!before.trajectory || before.trajectory->empty() || !after.trajectory || after.trajectory->empty())
+    return note("a run has no trajectory.tum poses");
+  const auto ds = [](const nlohmann::json& r) {
+    return r.is_object() && r.contains("dataset") && r["dataset"].is_string() ? r["dataset"].get<std::string>()
+                                                                             : std::string();
+  };
+  const std::string dataset = ds(after.report);
+  if (dataset.empty() || ds(before.report).empty()) return note("a report.json names no dataset");
+  std::error_code ec;
+  if (!fs::equivalent(dataset, ds(before.report), ec)) return note("the runs are of different datasets");
+  const int64_t from = std::max(before.trajectory->poses.front().t_ns, after.trajectory->poses.front().t_ns);
+  const int64_t to = std::min(before.trajectory->poses.back().t_ns, after.trajectory->poses.back().t_ns);
+  if (to <= from) return note("the runs' trajectories do not overlap in time");
+  const auto alignOf = [](const nlohmann::json& r) {
+    return r.is_object() && r.contains("eval") && r["eval"].is_object() && r["eval"].contains("align") &&
+                   r["eval"]["align"].is_string()
+               ? r["eval"]["align"].get<std::string>()
+               : std::string();
+  };
+  eval::AlignMode align = eval::AlignMode::kSim3;
+  try {
+    if (!alignOf(before.report).empty() && alignOf(before.report) == alignOf(after.report))
+      align = eval::parseAlignMode(alignOf(before.report));
+  } catch (const std::exception&) {
+  }
+  nlohmann::json j = {{"from_s", from * 1e-9}, {"to_s", to * 1e-9}, {"estimate", "trajectory.tum"}};
+  for (const auto& [key, dir] : {std::pair<std::string, std::string>{"before", before_dir}, {"after", after_dir}}) {
+    eval::FileEvalRequest req;
+    req.dataset_dir = dataset;
+    req.est_path = (fs::path(dir) / "trajectory.tum").string();
+    req.align = align;
+    req.est_from_ns = from;
+    req.est_to_ns = to;
+    try {
+      const eval::FileEvalOutcome o = eval::evaluateFiles(req);
+      j["frames_" + key] = o.estimates_in_span;
+      j["ate_" + key + "_m"] = o.result.ate_m.rmse;
+      j["align"] = eval::alignModeName(o.result.alignment.mode);
+    } catch (const std::exception& e) {
+      return note(std::string("not evaluated: ") + e.what());
+    }
+  }
+  const double b = j["ate_before_m"], a = j["ate_after_m"];
+  if (a > 0) j["ate_ratio"] = b / a;
   return j;
 }
 
@@ -375,6 +434,7 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
     if (std::isfinite(ate_b)) cmp["ate_before_m"] = ate_b;
     if (std::isfinite(ate_a)) cmp["ate_after_m"] = ate_a;
     if (std::isfinite(ate_b) && std::isfinite(ate_a) && ate_a > 0) cmp["ate_ratio"] = ate_b / ate_a;
+    cmp["common_span"] = commonSpanComparison(req.against, before, req.run_dir, run);
     nlohmann::json ev = nlohmann::json::array();
     for (const auto& e : b_rank) {
       const nlohmann::json* a = findEffect(a_rank, e["effect"].get<std::string>());
@@ -465,15 +525,37 @@ std::string formatDiagnosis(const nlohmann::json& d) {
   }
   if (d.contains("against")) {
     const auto& c = d["against"];
+    auto frames = [](const nlohmann::json& r) {
+      return r.contains("frames") ? ", " + std::to_string(r["frames"].get<long long>()) + " frames" : std::string();
+    };
     o << "against " << c["before_run"].get<std::string>() << ": before " << c["before"]["status"].get<std::string>()
-      << ", ATE " << (c.contains("ate_before_m") ? fmt(c["ate_before_m"].get<double>(), 4) + " m" : "n/a")
-      << "; after " << c["after"]["status"].get<std::string>() << ", ATE "
+      << frames(c["before"]) << ", ATE "
+      << (c.contains("ate_before_m") ? fmt(c["ate_before_m"].get<double>(), 4) + " m" : "n/a") << "; after "
+      << c["after"]["status"].get<std::string>() << frames(c["after"]) << ", ATE "
       << (c.contains("ate_after_m") ? fmt(c["ate_after_m"].get<double>(), 4) + " m" : "n/a");
     if (c.contains("ate_ratio")) {
       const double r = c["ate_ratio"].get<double>();  // before / after
-      o << " (" << (r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher") << ")";
+      o << " (" << (r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher");
+      const long long fb = c["before"].value("frames", 0LL), fa = c["after"].value("frames", 0LL);
+      if (fb != fa) o << ", over unequal spans";
+      o << ")";
     }
     o << "\n";
+    if (c.contains("common_span") && c["common_span"].contains("ate_before_m")) {
+      // Over the same frames: a run that failed early has a small ATE over its short span.
+      const auto& s = c["common_span"];
+      o << "  over the frames both tracked (" << fmt(s["to_s"].get<double>() - s["from_s"].get<double>(), 3)
+        << " s; " << s["frames_before"] << " / " << s["frames_after"] << " poses of trajectory.tum, "
+        << s["align"].get<std::string>() << "): ATE " << fmt(s["ate_before_m"].get<double>(), 4) << " m -> "
+        << fmt(s["ate_after_m"].get<double>(), 4) << " m";
+      if (s.contains("ate_ratio")) {
+        const double r = s["ate_ratio"].get<double>();
+        o << " (" << (r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher") << ")";
+      }
+      o << "\n";
+    } else if (c.contains("common_span") && c["common_span"].contains("note")) {
+      o << "  over the frames both tracked: not compared (" << c["common_span"]["note"].get<std::string>() << ")\n";
+    }
     for (const auto& e : c["evidence"]) {
       o << "  evidence " << e["effect"].get<std::string>() << ": " << fmt(e["statistic_before"].get<double>()) << " -> "
         << (e.contains("statistic_after") ? fmt(e["statistic_after"].get<double>()) : "n/a") << " (threshold "

@@ -1,6 +1,7 @@
 // File-level evaluation (rsvio/eval/evaluate_files.h).
 #include "rsvio/eval/evaluate_files.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "rsvio/core/error.h"
@@ -24,7 +25,11 @@ FileEvalOutcome evaluateFiles(const FileEvalRequest& req) {
   }
   if (gt_path.empty()) throw Error("evaluation needs a ground-truth file or a dataset folder");
   io::Trajectory gt = io::readGroundTruth(gt_path);
-  const io::Trajectory est = io::readTum(req.est_path);
+  io::Trajectory est = io::readTum(req.est_path);
+  est.poses.erase(std::remove_if(est.poses.begin(), est.poses.end(),
+                                 [&](const io::StampedPose& p) { return p.t_ns < req.est_from_ns || p.t_ns > req.est_to_ns; }),
+                  est.poses.end());
+  out.estimates_in_span = est.poses.size();
   ctx.gt_path = gt_path;
   ctx.est_path = req.est_path;
   ctx.est_frame = io::poseFrameName(est.frame);

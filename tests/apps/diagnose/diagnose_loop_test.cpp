@@ -122,6 +122,11 @@ TEST(DiagnoseLoop, AnExposureRampInTheStartIsNamedFromTheStartsCornersAndTheLine
     EXPECT_EQ(after.value("status", ""), "ok") << after.dump(1);
     EXPECT_EQ(after.value("frames", 0), 57);
     EXPECT_LT(ate(after), 0.05);
+    // The before-run has two poses: the error over the frames both tracked cannot be compared, and the
+    // comparison says why instead of an ATE of nothing.
+    const nlohmann::json cmp = diagnose(dir / "after", "--no-figures --against " + (dir / "before").string());
+    EXPECT_NE(cmp["against"]["common_span"].value("note", "").find("at least 3"), std::string::npos)
+        << cmp["against"]["common_span"].dump();
     const nlohmann::json no_gain = run(dir / "data", dir / "no_gain",
                                        "--set photometric.affine=null " + line + " --set backend.init_affine_min_change=100");
     EXPECT_EQ(no_gain.value("status", ""), "failed") << "the start's gain is what lets the run through";
@@ -158,6 +163,12 @@ void loop(const fs::path& dir, const fs::path& data, const std::string& base_set
   EXPECT_EQ(cmp["against"]["before_verdict"], effect);
   ASSERT_TRUE(cmp["against"].contains("evidence_gone"));
   if (evidence_must_go) EXPECT_TRUE(cmp["against"]["evidence_gone"].get<bool>()) << cmp["against"].dump(1);
+  // Both runs' error over the frames both tracked: never more of the after-run's poses than frames the
+  // before-run saw (its ATE covers only those when it failed).
+  const nlohmann::json& span = cmp["against"]["common_span"];
+  ASSERT_TRUE(span.contains("ate_before_m") && span.contains("ate_after_m")) << span.dump();
+  EXPECT_LE(span["frames_after"].get<int>(), before.value("frames", 0)) << span.dump();
+  EXPECT_GE(span["frames_before"].get<int>(), 3);
   // The figures exist and the run page links them.
   ASSERT_FALSE(d["figures"].empty());
   for (const auto& f : d["figures"]) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;

@@ -141,3 +141,30 @@ TEST_F(ExtrinsicTest, DatasetWithoutGroundTruthIsADataError) {
     EXPECT_NE(std::string(e.what()).find("no ground truth"), std::string::npos) << e.what();
   }
 }
+
+// FileEvalRequest's span: estimates outside [est_from_ns, est_to_ns] are left out before association
+// (diagnose --against compares two runs over the frames both tracked). The estimate is exact for its
+// first half and 0.5 m off after it: over the first half the ATE is zero, over the whole it is not.
+TEST_F(ExtrinsicTest, EstimatesOutsideTheSpanAreLeftOut) {
+  const io::Trajectory gt = test::lissajous(200, 50'000'000);
+  write("ds/mav0/state_groundtruth_estimate0/data.csv", eurocStateCsv(gt));
+  io::Trajectory est = gt;
+  est.frame = io::PoseFrame::kBody;
+  for (size_t i = 100; i < est.poses.size(); ++i) est.poses[i].p_W_X.z() += 0.5;
+  io::writeTum(path("half.tum"), est);
+  FileEvalRequest req;
+  req.dataset_dir = path("ds");
+  req.est_path = path("half.tum");
+  const FileEvalOutcome whole = evaluateFiles(req);
+  EXPECT_EQ(whole.estimates_in_span, 200u);
+  EXPECT_GT(whole.result.ate_m.rmse, 0.1);
+  req.est_from_ns = gt.poses[10].t_ns;
+  req.est_to_ns = gt.poses[99].t_ns;  // inclusive
+  const FileEvalOutcome first = evaluateFiles(req);
+  EXPECT_EQ(first.estimates_in_span, 90u);
+  EXPECT_EQ(first.result.association.pairs.size(), 90u);
+  EXPECT_LT(first.result.ate_m.rmse, 1e-6);
+  req.est_from_ns = gt.poses.back().t_ns + 1;  // nothing left: an error that says so, not an ATE of 0
+  req.est_to_ns = req.est_from_ns + 1000;
+  EXPECT_THROW(evaluateFiles(req), Error);
+}

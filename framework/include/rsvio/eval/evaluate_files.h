@@ -8,7 +8,11 @@
 // that is an error, not a silent comparison of different frames. Any other combination is compared as
 // given and EvalContext::frame_mapping says so.
 // Alignment: as asked, else defaultAlignFor(estimate frame) (Sim(3) for camera, SE(3) otherwise).
+// Span: estimates stamped outside [est_from_ns, est_to_ns] (the estimate's clock) are left out before
+// association, so two runs can be compared over the stamps both tracked (`rsvio diagnose --against`).
 #pragma once
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -24,11 +28,14 @@ struct FileEvalRequest {
   std::string calib_path;   // optional sensor.yaml holding T_BS; default <dataset_dir>/mav0/cam0/sensor.yaml
   std::optional<AlignMode> align;  // nullopt: defaultAlignFor(estimate frame)
   EvalOptions options;             // options.align is overwritten by the resolved alignment
+  int64_t est_from_ns = std::numeric_limits<int64_t>::min();  // estimates kept: from <= t_ns <= to
+  int64_t est_to_ns = std::numeric_limits<int64_t>::max();
 };
 
 struct FileEvalOutcome {
   EvalResult result;
   EvalContext context;
+  size_t estimates_in_span = 0;  // poses of the estimate file within [est_from_ns, est_to_ns]
 };
 
 // Throws DataError for unreadable files or a dataset without ground truth, Error for impossible
