@@ -13,7 +13,8 @@
 # over 8 s, 0.05 stops jitter), vignetting (vignette.json, corner at half), response (response.json,
 # gamma 2.2), rs_exposure (rs.json plus exposure.json's effect: two hidden effects, diagnosed in up to 3
 # rounds, one row each: both named one after the other, then none). "ratio" is ATE before / after; it
-# compares unequal spans when the before run failed. ROUNDS=2 diagnoses every after-run once more.
+# compares unequal spans when the before run failed; "same span" is that ratio over the frames both
+# runs tracked (diagnose --against's common span), with the before-run's poses there. ROUNDS=2 diagnoses every after-run once more.
 # time_offset (time_offset.json: 15 ms) and clean_vio start from configs/default.json (visual-inertial,
 # offset not estimated): run them with EFFECTS="time_offset" CLEAN="clean_vio".
 # START=default (a config name under configs/) starts every case from that config instead.
