@@ -299,6 +299,64 @@ std::string htmlEscape(const std::string& s) {
   return o;
 }
 
+std::string fmt(double v, int prec = 3) {
+  if (!std::isfinite(v)) return "n/a";
+  std::ostringstream os;
+  os.precision(prec);
+  os << v;
+  return os.str();
+}
+
+// A before / after ratio of errors: "3.2x lower" or "1.5x higher".
+std::string ratioText(double r) { return r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher"; }
+
+// The --against part of the diagnosis as text (the terminal and the run page's Diagnosis section).
+std::string formatAgainst(const nlohmann::json& c) {
+  std::ostringstream o;
+  auto frames = [](const nlohmann::json& r) {
+    return r.contains("frames") ? ", " + std::to_string(r["frames"].get<long long>()) + " frames" : std::string();
+  };
+  o << "against " << c["before_run"].get<std::string>() << ": before " << c["before"]["status"].get<std::string>()
+    << frames(c["before"]) << ", ATE "
+    << (c.contains("ate_before_m") ? fmt(c["ate_before_m"].get<double>(), 4) + " m" : "n/a") << "; after "
+    << c["after"]["status"].get<std::string>() << frames(c["after"]) << ", ATE "
+    << (c.contains("ate_after_m") ? fmt(c["ate_after_m"].get<double>(), 4) + " m" : "n/a");
+  if (c.contains("ate_ratio")) {
+    const double r = c["ate_ratio"].get<double>();  // before / after
+    o << " (" << ratioText(r);
+    const long long fb = c["before"].value("frames", 0LL), fa = c["after"].value("frames", 0LL);
+    if (fb != fa) o << ", over unequal spans";
+    o << ")";
+  }
+  o << "\n";
+  if (c.contains("common_span") && c["common_span"].contains("ate_before_m")) {
+    // Over the same frames: a run that failed early has a small ATE over its short span.
+    const auto& s = c["common_span"];
+    o << "  over the frames both tracked (" << fmt(s["to_s"].get<double>() - s["from_s"].get<double>(), 3)
+      << " s; " << s["frames_before"] << " / " << s["frames_after"] << " poses of trajectory.tum, "
+      << s["align"].get<std::string>() << "): ATE " << fmt(s["ate_before_m"].get<double>(), 4) << " m -> "
+      << fmt(s["ate_after_m"].get<double>(), 4) << " m";
+    if (s.contains("ate_ratio")) {
+      const double r = s["ate_ratio"].get<double>();
+      o << " (" << ratioText(r) << ")";
+    }
+    o << "\n";
+  } else if (c.contains("common_span") && c["common_span"].contains("note")) {
+    o << "  over the frames both tracked: not compared (" << c["common_span"]["note"].get<std::string>() << ")\n";
+  }
+  for (const auto& e : c["evidence"]) {
+    o << "  evidence " << e["effect"].get<std::string>() << ": " << fmt(e["statistic_before"].get<double>()) << " -> "
+      << (e.contains("statistic_after") ? fmt(e["statistic_after"].get<double>()) : "n/a") << " (threshold "
+      << fmt(e["threshold"].get<double>()) << ")";
+    if (e.contains("gone")) o << (e["gone"].get<bool>() ? ", below" : ", still above");
+    o << "\n";
+  }
+  if (c.contains("evidence_gone"))
+    o << "the evidence of " << c["before_verdict"].get<std::string>() << " is "
+      << (c["evidence_gone"].get<bool>() ? "gone" : "still there") << "\n";
+  return o.str();
+}
+
 // Adds (or replaces) the diagnosis section of <run>/index.html; writes a small page if there is none.
 void linkFromIndex(const fs::path& run, const nlohmann::json& d, const std::vector<std::string>& figures) {
   const fs::path index = run / "index.html";
@@ -314,6 +372,7 @@ void linkFromIndex(const fs::path& run, const nlohmann::json& d, const std::vect
         << e["threshold"].get<double>() << "</td><td>" << e["score"].get<double>() << "</td><td>"
         << e["plugin"].get<std::string>() << "</td></tr>\n";
   sec << "</table>\n";
+  if (d.contains("against")) sec << "<pre>" << htmlEscape(formatAgainst(d["against"])) << "</pre>\n";
   for (const auto& f : figures) {
     const std::string rel = fs::path(f).lexically_relative(run).generic_string();
     sec << "<figure><a href=\"" << rel << "\"><img src=\"" << rel << "\" width=\"640\"></a></figure>\n";
@@ -341,13 +400,6 @@ void linkFromIndex(const fs::path& run, const nlohmann::json& d, const std::vect
   fs::rename(tmp, index);
 }
 
-std::string fmt(double v, int prec = 3) {
-  if (!std::isfinite(v)) return "n/a";
-  std::ostringstream os;
-  os.precision(prec);
-  os << v;
-  return os.str();
-}
 
 }  // namespace
 
@@ -523,50 +575,7 @@ std::string formatDiagnosis(const nlohmann::json& d) {
       << "\n";
     o << "add: " << d["config_line"].get<std::string>() << "\n";
   }
-  if (d.contains("against")) {
-    const auto& c = d["against"];
-    auto frames = [](const nlohmann::json& r) {
-      return r.contains("frames") ? ", " + std::to_string(r["frames"].get<long long>()) + " frames" : std::string();
-    };
-    o << "against " << c["before_run"].get<std::string>() << ": before " << c["before"]["status"].get<std::string>()
-      << frames(c["before"]) << ", ATE "
-      << (c.contains("ate_before_m") ? fmt(c["ate_before_m"].get<double>(), 4) + " m" : "n/a") << "; after "
-      << c["after"]["status"].get<std::string>() << frames(c["after"]) << ", ATE "
-      << (c.contains("ate_after_m") ? fmt(c["ate_after_m"].get<double>(), 4) + " m" : "n/a");
-    if (c.contains("ate_ratio")) {
-      const double r = c["ate_ratio"].get<double>();  // before / after
-      o << " (" << (r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher");
-      const long long fb = c["before"].value("frames", 0LL), fa = c["after"].value("frames", 0LL);
-      if (fb != fa) o << ", over unequal spans";
-      o << ")";
-    }
-    o << "\n";
-    if (c.contains("common_span") && c["common_span"].contains("ate_before_m")) {
-      // Over the same frames: a run that failed early has a small ATE over its short span.
-      const auto& s = c["common_span"];
-      o << "  over the frames both tracked (" << fmt(s["to_s"].get<double>() - s["from_s"].get<double>(), 3)
-        << " s; " << s["frames_before"] << " / " << s["frames_after"] << " poses of trajectory.tum, "
-        << s["align"].get<std::string>() << "): ATE " << fmt(s["ate_before_m"].get<double>(), 4) << " m -> "
-        << fmt(s["ate_after_m"].get<double>(), 4) << " m";
-      if (s.contains("ate_ratio")) {
-        const double r = s["ate_ratio"].get<double>();
-        o << " (" << (r >= 1.0 ? fmt(r) + "x lower" : fmt(1.0 / r) + "x higher") << ")";
-      }
-      o << "\n";
-    } else if (c.contains("common_span") && c["common_span"].contains("note")) {
-      o << "  over the frames both tracked: not compared (" << c["common_span"]["note"].get<std::string>() << ")\n";
-    }
-    for (const auto& e : c["evidence"]) {
-      o << "  evidence " << e["effect"].get<std::string>() << ": " << fmt(e["statistic_before"].get<double>()) << " -> "
-        << (e.contains("statistic_after") ? fmt(e["statistic_after"].get<double>()) : "n/a") << " (threshold "
-        << fmt(e["threshold"].get<double>()) << ")";
-      if (e.contains("gone")) o << (e["gone"].get<bool>() ? ", below" : ", still above");
-      o << "\n";
-    }
-    if (c.contains("evidence_gone"))
-      o << "the evidence of " << c["before_verdict"].get<std::string>() << " is "
-        << (c["evidence_gone"].get<bool>() ? "gone" : "still there") << "\n";
-  }
+  if (d.contains("against")) o << formatAgainst(d["against"]);
   if (!d["figures"].empty()) {
     o << "figures:";
     for (const auto& f : d["figures"]) o << " " << f.get<std::string>();

@@ -169,6 +169,8 @@ void loop(const fs::path& dir, const fs::path& data, const std::string& base_set
   ASSERT_TRUE(span.contains("ate_before_m") && span.contains("ate_after_m")) << span.dump();
   EXPECT_LE(span["frames_after"].get<int>(), before.value("frames", 0)) << span.dump();
   EXPECT_GE(span["frames_before"].get<int>(), 3);
+  // The after-run's page shows the comparison.
+  EXPECT_NE(readFile(last / "index.html").find("over the frames both tracked"), std::string::npos);
   // The figures exist and the run page links them.
   ASSERT_FALSE(d["figures"].empty());
   for (const auto& f : d["figures"]) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;
