@@ -462,6 +462,18 @@ nlohmann::json diagnoseRun(const DiagnoseRequest& req, PluginHost& host) {
     d["plugin"] = ranking[0]["plugin"];
     d["config_line"] = ranking[0]["config_line"];
   }
+  // A run that failed part way may have ended before an effect's evidence grew above its threshold (a
+  // score statistic grows with the square root of the data). Its top probe, when at least half-way to
+  // its threshold, is given as a lead to test with its line: not a verdict (clean runs of the acceptance
+  // reach 0.73; docs/diagnose.md, "A lead when a failed run names nothing").
+  constexpr double kLeadMinScore = 0.5;
+  if (d["verdict"] == "none" && any_data && d["run_status"].value("status", "") == "failed" && !ranking.empty() &&
+      ranking[0]["score"].get<double>() >= kLeadMinScore)
+    d["lead"] = {{"effect", ranking[0]["effect"]},
+                 {"score", ranking[0]["score"]},
+                 {"min_score", kLeadMinScore},
+                 {"plugin", ranking[0]["plugin"]},
+                 {"config_line", ranking[0]["config_line"]}};
 
   nlohmann::json after_ranking_for_fig;
   bool have_after = false;
@@ -570,6 +582,13 @@ std::string formatDiagnosis(const nlohmann::json& d) {
          "  during its start logs almost nothing)\n";
   } else if (d["verdict"] == "none") {
     o << "verdict: none (no probe's statistic above its threshold)\n";
+    if (d.contains("lead")) {
+      const auto& l = d["lead"];
+      o << "lead: " << l["effect"].get<std::string>() << " at " << fmt(l["score"].get<double>(), 2)
+        << " of its threshold; the run failed after " << fmt(d["data"].value("span_s", 0.0), 2)
+        << " s, perhaps before that evidence could grow. Not a verdict: to test it, run again with\n  "
+        << l["config_line"].get<std::string>() << "\n";
+    }
   } else {
     o << "verdict: " << d["verdict"].get<std::string>() << " -- " << d["ranking"][0]["explanation"].get<std::string>()
       << "\n";

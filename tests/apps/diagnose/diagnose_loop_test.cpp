@@ -235,7 +235,9 @@ TEST(DiagnoseLoop, RollingShutterNamedAndTheRollingShutterModelMakesTheErrorFall
 // (|z| 3.0 against 4). The tracker keeps a frame whose explained ratio falls gradually
 // (frontend.track_explained_keep_fraction, docs/frontend.md "Poorly explained frames"): the run tracks all
 // 57 frames (ATE 80 mm), its report warns of the poorly explained frames, and the probe names the rolling
-// shutter (|z| 6.7). With the rule off the run fails at frame 16 as before and nothing is named.
+// shutter (|z| 6.7). With the rule off the run fails at frame 16 as before and nothing is named, but
+// the failed run's rolling-shutter probe is 0.75 of the way to its threshold: the diagnosis gives it as
+// a lead to test (not a verdict), and its line tracks the sequence. Clean runs that end ok never get one.
 TEST(DiagnoseLoop, RollingShutterNamedWhereTheGlobalShutterModelExplainsTheFramesLessAndLess) {
   const fs::path dir = workDir("rolling_shutter_kept");
   simulate(dir / "data", 1, "", "tiny_rs.json");
@@ -245,7 +247,20 @@ TEST(DiagnoseLoop, RollingShutterNamedWhereTheGlobalShutterModelExplainsTheFrame
   EXPECT_EQ(diagnose(dir / "kept", "--no-figures")["verdict"], "rolling_shutter");
   const nlohmann::json lost = run(dir / "data", dir / "lost", "--set frontend.track_explained_keep_fraction=0");
   EXPECT_EQ(lost["status"], "failed");
-  EXPECT_EQ(diagnose(dir / "lost", "--no-figures")["verdict"], "none");
+  const nlohmann::json d = diagnose(dir / "lost", "--no-figures");
+  EXPECT_EQ(d["verdict"], "none");
+  ASSERT_TRUE(d.contains("lead")) << d.dump(1);
+  EXPECT_EQ(d["lead"]["effect"], "rolling_shutter");
+  EXPECT_FALSE(d.contains("config_line")) << "a lead is not a verdict";
+  const nlohmann::json tested = run(dir / "data", dir / "lead",
+                                    "--set frontend.track_explained_keep_fraction=0 " + d["lead"]["config_line"].get<std::string>());
+  EXPECT_EQ(tested["status"], "ok") << tested.dump(1);
+  // The same log from a run that ended ok: nothing stands out, no lead.
+  fs::copy(dir / "lost", dir / "lost_ok", fs::copy_options::recursive);
+  nlohmann::json rep = lost;
+  rep["status"] = "ok";
+  std::ofstream(dir / "lost_ok" / "report.json") << rep.dump();
+  EXPECT_FALSE(diagnose(dir / "lost_ok", "--no-figures").contains("lead")) << "an ok run gets no lead";
 }
 
 // Camera-IMU time offset (the image stamped t_cam is captured at IMU time t_cam + 20 ms), starting from
