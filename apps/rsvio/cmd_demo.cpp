@@ -21,7 +21,6 @@
 #include "render_hook.h"
 #include "run_summary.h"
 #include "rsvio/core/error.h"
-#include "rsvio/core/time.h"
 #include "rsvio/pipeline/run.h"
 #include "rsvio/plugin/host.h"
 #include "rsvio/sim/simulator.h"
