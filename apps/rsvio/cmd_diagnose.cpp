@@ -170,7 +170,9 @@ nlohmann::json commonSpanComparison(const std::string& before_dir, const LoadedR
   const std::string dataset = ds(after.report);
   if (dataset.empty() || ds(before.report).empty()) return note("a report.json names no dataset");
   std::error_code ec;
-  if (!fs::equivalent(dataset, ds(before.report), ec)) return note("the runs are of different datasets");
+  if (dataset != ds(before.report) && !fs::equivalent(dataset, ds(before.report), ec))
+    return note(ec ? "the runs' datasets do not open from here (" + dataset + ", " + ds(before.report) + ")"
+                   : "the runs are of different datasets");
   const int64_t from = std::max(before.trajectory->poses.front().t_ns, after.trajectory->poses.front().t_ns);
   const int64_t to = std::min(before.trajectory->poses.back().t_ns, after.trajectory->poses.back().t_ns);
   if (to <= from) return note("the runs' trajectories do not overlap in time");
