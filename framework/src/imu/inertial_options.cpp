@@ -79,6 +79,14 @@ ParamTable inertialParamTable() {
       paramInt("init_refusals_warn", d.init_refusals_warn, 0, 1000000, "",
                "warn when the initialisation succeeded only after this many refused attempts (the start's "
                "keyframe poses did not fit the IMU: the trajectory before it may be broken); 0: no warning"),
+      paramInt("init_restart_refusals", d.init_restart_refusals, 0, 1000000, "",
+               "before the visual-inertial initialisation: start again (window, tracking, monocular start) when "
+               "the initialisation was refused this many times in the attempt, or when the attempt failed; "
+               "0: off"),
+      paramInt("init_max_restarts", d.init_max_restarts, 0, 100, "", "the most restarts of the start in a run"),
+      paramDouble("init_restart_within_s", d.init_restart_within_s, 0.0, 1e6, "s",
+                  "a start is restarted only within this time of its first keyframe (its points and "
+                  "observation rows are held back until then)"),
       paramBool("dynamic_marginalization", d.dynamic_marginalization,
                 "dynamic marginalisation for the scale (VI-DSO): the window switches to a second prior holding "
                 "only newer IMU factors and twist energies when the scale leaves the interval around the first's"),
@@ -132,6 +140,9 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.init_min_interval_s = p.getDouble("init_min_interval_s");
   o.init_max_imu_chi2 = p.getDouble("init_max_imu_chi2");
   o.init_refusals_warn = static_cast<int>(p.getInt("init_refusals_warn"));
+  o.init_restart_refusals = static_cast<int>(p.getInt("init_restart_refusals"));
+  o.init_max_restarts = static_cast<int>(p.getInt("init_max_restarts"));
+  o.init_restart_within_s = p.getDouble("init_restart_within_s");
   o.dynamic_marginalization = p.getBool("dynamic_marginalization");
   o.dynamic_marginalization_interval = p.getDouble("dynamic_marginalization_interval");
   o.init_scale_factor = p.getDouble("init_scale_factor");

@@ -38,6 +38,12 @@ InertialState::InertialState(const InertialOptions& o, const SensorSetup& sensor
   term_ = std::make_unique<InertialTerm>(to, T_cm_i_, &globals_);
 }
 
+std::unique_ptr<InertialState> InertialState::restarted(GlobalStates& globals) const {
+  auto s = std::make_unique<InertialState>(o_, sensors_, rolling_, twist_sigma_t_, twist_sigma_r_, globals);
+  s->buffer_ = buffer_;
+  return s;
+}
+
 int64_t InertialState::offsetNs() const { return sToNs(globals_.state.time_offset_s); }
 
 void InertialState::addImu(const ImuSample& s) {

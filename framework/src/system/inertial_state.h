@@ -40,6 +40,9 @@ class InertialState {
   InertialState(const InertialOptions& o, const SensorSetup& sensors, bool rolling, double twist_sigma_trans_m_s,
                 double twist_sigma_rot_rad_s, GlobalStates& globals);
 
+  // A fresh state for a restarted start (Odometry::Impl::restart) on the new window's globals: the same
+  // options and sensors, this one's IMU buffer; nothing else (not initialised, no refusals).
+  std::unique_ptr<InertialState> restarted(GlobalStates& globals) const;
   bool enabled() const { return o_.enabled; }
   bool initialised() const { return initialised_; }
   const std::string& status() const { return status_; }  // why it is not initialised yet (or "initialised")

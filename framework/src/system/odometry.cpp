@@ -97,16 +97,14 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
   ws.dynamic_marginalization.enabled = io.enabled && io.dynamic_marginalization;
   ws.dynamic_marginalization.interval = io.dynamic_marginalization_interval;
 
-  record = std::make_unique<RunRecord>(*camera, timing, rolling, estimate_affine, sensors.camera);
-  TrackerOptions to = fo.track;
-  to.residual = fo.residual;
-  to.estimate_a = to.estimate_b = estimate_affine;
-  to.threads = threads;
-  std::vector<const MotionPrior*> motion_ptrs;
+  window_setup = ws;
+  tracker_options = fo.track;
+  tracker_options.residual = fo.residual;
+  tracker_options.estimate_a = tracker_options.estimate_b = estimate_affine;
+  tracker_options.threads = threads;
   for (const auto& m : motion) motion_ptrs.push_back(m.get());
-  tracking = std::make_unique<Tracking>(to, *camera, timing, motion_ptrs);
-  window = std::make_unique<KeyframeWindow>(ws, *camera, timing, *solver);
-  start = std::make_unique<MonoStart>(bo, *camera, timing);
+  record = std::make_unique<RunRecord>(*camera, timing, rolling, estimate_affine, sensors.camera);
+  window = std::make_unique<KeyframeWindow>(window_setup, *camera, timing, *solver);
   if (io.enabled) {
     if (!sensors.has_imu)
       throw ConfigError("imu.enabled: the dataset " + sensors.dataset_dir +
@@ -116,21 +114,11 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
     for (const auto& m : motion)
       if (m->twistEnergySigma(&sigma_t, &sigma_r)) break;
     inertial = std::make_unique<InertialState>(io, sensors, rolling, sigma_t, sigma_r, window->globals());
-    window->setInertial(inertial.get());
-    if (rolling && io.init_rates_from_gyro) {
-      const InertialState* in = inertial.get();
-      start->setRateSource([in](int64_t t_ns, Vec3* w) { return in->gyroRate(t_ns, Vec3::Zero(), w); });
-    }
-    if (io.init_track_guess_from_gyro) {
-      const InertialState* in = inertial.get();
-      start->setTrackGuessSource([in](int64_t t0_ns, int64_t t1_ns, SO3d* R) {
-        return in->gyroRotation(t0_ns, t1_ns, Vec3::Zero(), R);
-      });
-    }
-    record->setGlobals(&window->globals());
+    record->setProvisional(io.init_restart_refusals > 0 && io.init_max_restarts > 0);
   } else if (sensors.has_imu) {
     record->addWarning("the dataset has an IMU; this estimator runs pure visual odometry (IMU ignored)");
   }
+  makeParts();
   // Models estimated online by alternation (photometric.vignette without a calibration) get the rows
   // of what leaves the window (refinePhotometric). Any other model's own parameters
   // (PhotometricModel::numParams, e.g. photometric.response's gamma in mode "estimate") are not
@@ -143,6 +131,56 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
       record->addWarning(photometric_keys[i] + ": its " + std::to_string(n) +
                          " parameter(s) are not estimated by the back end; the model leaves the images as "
                          "they are (a calibrated mode applies it)");
+}
+
+void Odometry::Impl::makeParts() {
+  if (!window) window = std::make_unique<KeyframeWindow>(window_setup, *camera, timing, *solver);
+  tracking = std::make_unique<Tracking>(tracker_options, *camera, timing, motion_ptrs);
+  start = std::make_unique<MonoStart>(bo, *camera, timing);
+  if (!inertial) return;
+  window->setInertial(inertial.get());
+  record->setGlobals(&window->globals());
+  const InertialState* in = inertial.get();
+  if (rolling && in->options().init_rates_from_gyro)
+    start->setRateSource([in](int64_t t_ns, Vec3* w) { return in->gyroRate(t_ns, Vec3::Zero(), w); });
+  if (in->options().init_track_guess_from_gyro)
+    start->setTrackGuessSource(
+        [in](int64_t t0_ns, int64_t t1_ns, SO3d* R) { return in->gyroRotation(t0_ns, t1_ns, Vec3::Zero(), R); });
+}
+
+bool Odometry::Impl::canRestart(int64_t t_ns) const {
+  if (!inertial || inertial->initialised() || !initialized) return false;
+  const InertialOptions& o = inertial->options();
+  return o.init_restart_refusals > 0 && static_cast<int>(restarts.size()) < o.init_max_restarts &&
+         attempt_t0_ns >= 0 && nsToS(t_ns - attempt_t0_ns) <= o.init_restart_within_s;
+}
+
+// Restart (InertialOptions::init_restart_refusals): the attempt's keyframes, points and rows are
+// dropped and its frames become untracked (RunRecord::restart); the window (with its global states),
+// the tracking and the monocular start are made afresh, the line delay back at its start value, and
+// the inertial state starts again with the IMU buffer it has. The next frame begins a new start.
+void Odometry::Impl::restart(int64_t frame_index, int64_t t_ns, const std::string& why) {
+  std::ostringstream os;
+  os << "the start was discarded at frame " << frame_index << " (t " << io::formatSeconds(t_ns)
+     << " s) and begun again from the next frame: " << why;
+  record->addWarning(os.str());
+  restarts.push_back({{"frame", frame_index}, {"t_s", nsToS(t_ns)}, {"reason", why}});
+  record->restart();
+  timing.line_delay_s = line_delay_start_s;
+  auto w = std::make_unique<KeyframeWindow>(window_setup, *camera, timing, *solver);
+  auto in = inertial->restarted(w->globals());
+  window = std::move(w);
+  inertial = std::move(in);
+  makeParts();
+  initialized = false;
+  failed = false;
+  failure.clear();
+  vi_init_t_ns = -1;
+  poorly_explained_frames = 0;
+  first_poorly_explained = -1;
+  attempt_first_frame = frame_index + 1;
+  attempt_t0_ns = -1;
+  record->setProvisional(static_cast<int>(restarts.size()) < inertial->options().init_max_restarts);
 }
 
 // Visual-inertial: the initialisation at each new keyframe until it succeeds, on the keyframe poses of
@@ -276,6 +314,14 @@ FrameStatus Odometry::Impl::track(const Frame& frame, std::shared_ptr<const Imag
     ScopedStage st(record->stages(), "keyframe");
     makeKeyframe(frame.index, frame.t_ns, frame.exposure_ms, std::move(pyr), r.T_c_w, r.affine,
                  rolling && r.rate_estimated ? &xi_frame : nullptr);
+  }
+  if (!failed && canRestart(frame.t_ns) && inertial->refusals() >= inertial->options().init_restart_refusals) {
+    std::ostringstream os;
+    os << "the visual-inertial initialisation was refused " << inertial->refusals()
+       << " times (imu.init_restart_refusals " << inertial->options().init_restart_refusals
+       << "; first: " << inertial->firstRefusal() << ")";
+    restart(frame.index, frame.t_ns, os.str());
+    return FrameStatus{false, false, "restarted: " + os.str()};
   }
   return FrameStatus{true, true, failed ? "failed: " + failure : "keyframe (" + why + ")"};
 }
@@ -433,7 +479,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   rec.exposure_ms = frame.exposure_ms;
   if (!done) {
     record->addFrame(rec);
-    const int64_t first = record->frames().front().index;
+    const int64_t first = attempt_first_frame;
     if (frame.index - first + 1 >= bo.init_max_frames) {
       std::ostringstream os;
       os << "monocular initialisation failed after " << (frame.index - first + 1) << " frames: " << start->status();
@@ -447,6 +493,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   ScopedStage st(record->stages(), "initialise");
   const MonoStart::StartFrame ref = start->reference();
   const SE3d T_cur_ref = start->T_cur_ref();
+  attempt_t0_ns = ref.t_ns;
   if (FrameRecord* r = record->frame(ref.index)) {
     r->tracked = true;
     r->T_c_w = SE3d();
@@ -538,6 +585,7 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
 }
 
 void Odometry::Impl::finish() {
+  record->setProvisional(false);
   // A late initialisation after many refusals: the start's keyframe poses did not fit the IMU
   // (InertialOptions::init_refusals_warn). Not a failure: the run after it may be sound.
   if (inertial && inertial->initialised() && inertial->options().init_refusals_warn > 0 &&
@@ -607,14 +655,28 @@ FrameStatus Odometry::addFrame(const Frame& frame) {
       working = prepareWorkingImage(frame, m.photometric_ptrs);
       pyr = std::make_shared<ImagePyramid>(working, m.fo.pyramid_levels);
     }
-    if (!m.initialized) return m.initialise(frame, std::move(pyr), working);
-    return m.track(frame, std::move(pyr));
+    if (m.attempt_first_frame < 0) m.attempt_first_frame = frame.index;
+    FrameStatus st = m.initialized ? m.track(frame, std::move(pyr)) : m.initialise(frame, std::move(pyr), working);
+    return m.afterFrame(frame, std::move(st));
   } catch (const DataError&) {
     throw;
   } catch (const Error& e) {
     m.fail(std::string("frame ") + std::to_string(frame.index) + ": " + e.what());
-    return FrameStatus{false, false, "failed: " + m.failure};
+    return m.afterFrame(frame, FrameStatus{false, false, "failed: " + m.failure});
   }
+}
+
+// A failed attempt that may still be restarted is restarted instead; the record stays provisional
+// only while a restart may come.
+FrameStatus Odometry::Impl::afterFrame(const Frame& frame, FrameStatus st) {
+  if (failed && canRestart(frame.t_ns)) {
+    const std::string why = "the attempt failed: " + failure;
+    restart(frame.index, frame.t_ns, why);
+    return FrameStatus{false, false, "restarted: " + why};
+  }
+  if (record->provisional() && initialized && attempt_t0_ns >= 0 && !canRestart(frame.t_ns))
+    record->setProvisional(false);
+  return st;
 }
 
 void Odometry::finish() { impl_->finish(); }
@@ -631,7 +693,8 @@ nlohmann::json Odometry::inertialReport() const {
   nlohmann::json j;
   j["initialised"] = m.inertial->initialised();
   j["status"] = m.inertial->status();
-  j["init_refusals"] = m.inertial->refusals();
+  j["init_refusals"] = m.inertial->refusals();  // of the kept attempt
+  if (m.inertial->options().init_restart_refusals > 0) j["start_restarts"] = m.restarts;
   if (m.inertial->refusals() > 0) {
     j["init_first_refusal_at_s"] = nsToS(m.inertial->firstRefusalNs());
     j["init_first_refusal"] = m.inertial->firstRefusal();

@@ -70,6 +70,10 @@ struct Odometry::Impl {
   std::unique_ptr<KeyframeWindow> window;  // (a)
   std::unique_ptr<MonoStart> start;        // (d)
   std::unique_ptr<InertialState> inertial; // (e) null for visual odometry
+  // What the parts are made from (kept for a restart).
+  WindowSetup window_setup;
+  TrackerOptions tracker_options;
+  std::vector<const MotionPrior*> motion_ptrs;
   // Run status.
   bool initialized = false;
   bool failed = false;
@@ -79,8 +83,23 @@ struct Odometry::Impl {
   // at the end, and a hint for rsvio diagnose.
   int64_t poorly_explained_frames = 0;
   int64_t first_poorly_explained = -1;
+  // Restarts of the start (InertialOptions::init_restart_refusals): the current attempt's first frame
+  // (-1: none yet) and first keyframe time (-1: not started), and each restart (report.json extra.vio).
+  int64_t attempt_first_frame = -1;
+  int64_t attempt_t0_ns = -1;
+  nlohmann::json restarts = nlohmann::json::array();
 
   Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSetup& s);
+  // The window, tracking and monocular start from window_setup, tracker_options and motion_ptrs,
+  // wired to the inertial state (when there is one) and the record.
+  void makeParts();
+  // A restart may still happen at camera time t_ns (the contract of InertialOptions::init_restart_refusals).
+  bool canRestart(int64_t t_ns) const;
+  // Discards the attempt (RunRecord::restart), makes the parts afresh (the inertial state keeps its IMU
+  // buffer) and waits for a new monocular start from the next frame.
+  void restart(int64_t frame_index, int64_t t_ns, const std::string& why);
+  // After each frame: a failed attempt restarted where it may be, the record's provisional flag.
+  FrameStatus afterFrame(const Frame& frame, FrameStatus st);
 
   FrameStatus initialise(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr, const cv::Mat& working);
   FrameStatus track(const Frame& frame, std::shared_ptr<const ImagePyramid> pyr);

@@ -39,6 +39,7 @@ FrameRecord* RunRecord::frame(int64_t index) {
 }
 
 void RunRecord::takeObservations(std::vector<ObservationRow>* rows) {
+  if (provisional_) return;
   if (rows->empty()) {
     rows->swap(diag_.observations);  // the two buffers trade places: no copy, capacities kept
   } else {
@@ -62,7 +63,24 @@ void RunRecord::addTrackRows(int64_t index, int64_t t_ns, int64_t from,
   }
 }
 
+void RunRecord::restart() {
+  for (FrameRecord& f : frames_) {
+    f.tracked = false;
+    f.keyframe = false;
+    f.ref_kf_id = -1;
+    f.T_f_ref = SE3d();
+    f.T_c_w = SE3d();
+    f.affine = AffineBrightness();
+  }
+  keyframes_.clear();
+  map_points_.clear();
+  point_host_.clear();
+  diag_.observations.clear();
+  photometric_rows_.clear();
+}
+
 void RunRecord::takePoints(std::vector<MapPoint>* points) {
+  if (provisional_) return;
   if (metric_) toMetric(&map_points_);
   if (points->empty()) {
     points->swap(map_points_);

@@ -118,6 +118,15 @@ class RunRecord : public WindowSink {
   // those of a keyframe that left in the settling second take the current scale when no settled
   // record exists yet).
   void takePoints(std::vector<MapPoint>* points);
+  // Provisional (a start that may still be restarted, Odometry::Impl::restart): takeObservations and
+  // takePoints give nothing, so what a restart discards was never written out; the observation rows
+  // and points stay here until it is set false.
+  void setProvisional(bool on) { provisional_ = on; }
+  bool provisional() const { return provisional_; }
+  // A restart of the start (before the visual-inertial initialisation only): every frame so far becomes
+  // untracked (no keyframe, no reference), and the keyframe records, map points, observation rows and
+  // rows kept for photometric models are dropped. Track rows, stage times and warnings stay.
+  void restart();
 
   // Outputs, with the keyframes and points still in `window` at their current state.
   // Trajectories are camera poses in W_f. With T_wm_wf given (visual-inertial, after the
@@ -165,6 +174,7 @@ class RunRecord : public WindowSink {
   RxSO3d currentTransform() const { return globals_->state.T_wm_wf; }
   DiagnosticsLog diag_;
   bool keep_photometric_ = false;
+  bool provisional_ = false;
   std::vector<ObservationRow> photometric_rows_;
   StageTimes stages_;
   std::vector<std::string> warnings_;

@@ -42,6 +42,9 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["init_min_interval_s"] = o.init_min_interval_s;
   got["init_max_imu_chi2"] = o.init_max_imu_chi2;
   got["init_refusals_warn"] = o.init_refusals_warn;
+  got["init_restart_refusals"] = o.init_restart_refusals;
+  got["init_max_restarts"] = o.init_max_restarts;
+  got["init_restart_within_s"] = o.init_restart_within_s;
   got["dynamic_marginalization"] = o.dynamic_marginalization;
   got["dynamic_marginalization_interval"] = o.dynamic_marginalization_interval;
   got["init_scale_factor"] = o.init_scale_factor;

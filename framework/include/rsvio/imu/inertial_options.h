@@ -99,6 +99,17 @@ struct InertialOptions {
   // 830 and 231 mm; the demo's default model on its hidden rolling shutter: 23, 0.89 m; 0-11 in 56
   // visual-inertial runs that ended well, docs/vio.md). 0: no warning.
   int init_refusals_warn = 20;
+  // Restart of a start that does not fit the IMU (Odometry::Impl::restart; DSO resets its system,
+  // VINS-Mono reinitialises): before the visual-inertial initialisation, within init_restart_within_s
+  // of the attempt's first keyframe, the window, tracking and monocular start begin again from the
+  // next frame when the initialisation was refused init_restart_refusals times in this attempt, or
+  // when the attempt failed (tracking lost, visual divergence); at most init_max_restarts times per run.
+  // The attempt's frames become untracked; its points and observation rows are held back until the
+  // attempt is kept (RunRecord::setProvisional), so nothing of a discarded attempt is written.
+  // init_restart_refusals 0: off (the run fails, or initialises late, as without it).
+  int init_restart_refusals = 0;
+  int init_max_restarts = 2;
+  double init_restart_within_s = 10.0;
   // Dynamic marginalisation for the scale (backend/dynamic_marginalization.h): a second prior with only
   // the scale-dependent terms since the scale entered its current half-interval, switched in when the
   // scale leaves [s_mid / d, s_mid * d]; d = dynamic_marginalization_interval.
