@@ -85,7 +85,7 @@ ParamTable inertialParamTable() {
                "0: off"),
       paramInt("init_max_restarts", d.init_max_restarts, 0, 100, "", "the most restarts of the start in a run"),
       paramDouble("init_restart_within_s", d.init_restart_within_s, 0.0, 1e6, "s",
-                  "a start is restarted only within this time of its first keyframe (its points and "
+                  "a start is restarted only within this time of its first frame (its points and "
                   "observation rows are held back until then)"),
       paramBool("dynamic_marginalization", d.dynamic_marginalization,
                 "dynamic marginalisation for the scale (VI-DSO): the window switches to a second prior holding "

@@ -149,7 +149,7 @@ void Odometry::Impl::makeParts() {
 }
 
 bool Odometry::Impl::canRestart(int64_t t_ns) const {
-  if (!inertial || inertial->initialised() || !initialized) return false;
+  if (!inertial || inertial->initialised()) return false;
   const InertialOptions& o = inertial->options();
   return o.init_restart_refusals > 0 && static_cast<int>(restarts.size()) < o.init_max_restarts &&
          attempt_t0_ns >= 0 && nsToS(t_ns - attempt_t0_ns) <= o.init_restart_within_s;
@@ -178,7 +178,7 @@ void Odometry::Impl::restart(int64_t frame_index, int64_t t_ns, const std::strin
   vi_init_t_ns = -1;
   poorly_explained_frames = 0;
   first_poorly_explained = -1;
-  attempt_first_frame = frame_index + 1;
+  attempt_first_frame = -1;  // the next frame's
   attempt_t0_ns = -1;
   record->setProvisional(static_cast<int>(restarts.size()) < inertial->options().init_max_restarts);
 }
@@ -493,7 +493,6 @@ FrameStatus Odometry::Impl::initialise(const Frame& frame, std::shared_ptr<const
   ScopedStage st(record->stages(), "initialise");
   const MonoStart::StartFrame ref = start->reference();
   const SE3d T_cur_ref = start->T_cur_ref();
-  attempt_t0_ns = ref.t_ns;
   if (FrameRecord* r = record->frame(ref.index)) {
     r->tracked = true;
     r->T_c_w = SE3d();
@@ -612,8 +611,13 @@ void Odometry::Impl::finish() {
     // The sequence ended before the monocular start succeeded: nothing was estimated, and saying
     // "ok" would hide it.
     std::ostringstream os;
-    os << "monocular initialisation did not succeed in the " << record->frames().size()
-       << " frames of the sequence: " << start->status();
+    if (restarts.empty())
+      os << "monocular initialisation did not succeed in the " << record->frames().size()
+         << " frames of the sequence: " << start->status();
+    else
+      os << "monocular initialisation did not succeed in the "
+         << (record->frames().empty() || attempt_first_frame < 0 ? 0 : record->frames().back().index - attempt_first_frame + 1)
+         << " frames since the start was begun again (" << restarts.size() << " restarts): " << start->status();
     fail(os.str());
   }
   if (window->empty()) return;
@@ -655,7 +659,10 @@ FrameStatus Odometry::addFrame(const Frame& frame) {
       working = prepareWorkingImage(frame, m.photometric_ptrs);
       pyr = std::make_shared<ImagePyramid>(working, m.fo.pyramid_levels);
     }
-    if (m.attempt_first_frame < 0) m.attempt_first_frame = frame.index;
+    if (m.attempt_first_frame < 0) {
+      m.attempt_first_frame = frame.index;
+      m.attempt_t0_ns = frame.t_ns;
+    }
     FrameStatus st = m.initialized ? m.track(frame, std::move(pyr)) : m.initialise(frame, std::move(pyr), working);
     return m.afterFrame(frame, std::move(st));
   } catch (const DataError&) {
@@ -674,7 +681,7 @@ FrameStatus Odometry::Impl::afterFrame(const Frame& frame, FrameStatus st) {
     restart(frame.index, frame.t_ns, why);
     return FrameStatus{false, false, "restarted: " + why};
   }
-  if (record->provisional() && initialized && attempt_t0_ns >= 0 && !canRestart(frame.t_ns))
+  if (record->provisional() && !canRestart(frame.t_ns))
     record->setProvisional(false);
   return st;
 }

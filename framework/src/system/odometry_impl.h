@@ -84,7 +84,7 @@ struct Odometry::Impl {
   int64_t poorly_explained_frames = 0;
   int64_t first_poorly_explained = -1;
   // Restarts of the start (InertialOptions::init_restart_refusals): the current attempt's first frame
-  // (-1: none yet) and first keyframe time (-1: not started), and each restart (report.json extra.vio).
+  // and its time (-1: none yet), and each restart (report.json extra.vio start_restarts).
   int64_t attempt_first_frame = -1;
   int64_t attempt_t0_ns = -1;
   nlohmann::json restarts = nlohmann::json::array();

@@ -101,11 +101,12 @@ struct InertialOptions {
   int init_refusals_warn = 20;
   // Restart of a start that does not fit the IMU (Odometry::Impl::restart; DSO resets its system,
   // VINS-Mono reinitialises): before the visual-inertial initialisation, within init_restart_within_s
-  // of the attempt's first keyframe, the window, tracking and monocular start begin again from the
-  // next frame when the initialisation was refused init_restart_refusals times in this attempt, or
-  // when the attempt failed (tracking lost, visual divergence); at most init_max_restarts times per run.
-  // The attempt's frames become untracked; its points and observation rows are held back until the
-  // attempt is kept (RunRecord::setProvisional), so nothing of a discarded attempt is written.
+  // of the attempt's first frame, the window, tracking and monocular start begin again from the next
+  // frame when the initialisation was refused init_restart_refusals times in this attempt, or when the
+  // attempt failed (the monocular start found no pair in backend.init_max_frames frames, tracking
+  // lost, visual divergence); at most init_max_restarts times per run. The attempt's frames become
+  // untracked; its points and observation rows are held back until the attempt can no longer be
+  // discarded (RunRecord::setProvisional), so nothing of a discarded attempt is written.
   // init_restart_refusals 0: off (the run fails, or initialises late, as without it).
   int init_restart_refusals = 0;
   int init_max_restarts = 2;
