@@ -5,7 +5,9 @@
 #     rs_vio on RS data with the true line delay given (58.94 us),
 #     gs_vio on RS data (the model that lacks the effect),
 #     gs_vio on the GS twin (the reference),
-#   and tabulate status, frames, keyframe ATE (SE(3): metric, the paper's eq. 35; Sim(3) and its
+#   and tabulate status, frames, the span of the evaluated keyframes (s; a start begun again,
+#   imu.init_restart_refusals, leaves its first seconds out: "rst" counts the restarts), keyframe ATE
+#   (SE(3): metric, the paper's eq. 35; Sim(3) and its
 #   scale), the time and scale of the visual-inertial initialisation and the final scale; with several
 #   sequences also one line per sequence (medians over the seeds) and the medians over all runs.
 #
@@ -110,12 +112,14 @@ def inf_median(v):
 def mm(v):
     return "fail" if v == float("inf") else "%.1f" % (1e3 * v)
 print()
-print("%-4s %-4s %-12s %7s %7s %9s %10s %7s %8s %8s %7s %5s %7s  %s" % ("seq", "seed", "mode", "status", "frames",
-      "SE3 (mm)", "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "dt (ms)", "error"))
+print("%-4s %-4s %-12s %7s %7s %9s %3s %9s %10s %7s %8s %8s %7s %5s %7s  %s" % ("seq", "seed", "mode", "status", "frames",
+      "span (s)", "rst", "SE3 (mm)", "Sim3 (mm)", "scale", "init (s)", "s_init", "s_end", "dm", "dt (ms)", "error"))
 allv = {m: [] for m in modes}       # SE(3) ATE per run (failed = inf)
 perseq = {}                         # (seq, mode) -> median over the seeds
 scales = []                         # Sim(3) scales of successful rs_vio / gs_vio runs
 offsets = []                        # estimated time offsets (ms) of successful runs on the offset data
+spans = {m: [] for m in modes}      # evaluated keyframe spans (s) of successful runs
+restarted = {m: 0 for m in modes}   # runs whose start was begun again
 for seq in seqs:
     for mode in modes:
         vals = []
@@ -141,8 +145,13 @@ for seq in seqs:
             dm = vio.get("dynamic_marginalization")
             if ok and vio.get("time_offset_ms") is not None and mode.endswith("_rsto"):
                 offsets.append(vio["time_offset_ms"])
-            print("%-4s %-4s %-12s %7s %7d %9s %10s %7s %8s %8s %7s %5s %7s  %s" % (
-                seq, seed, mode, r["status"], r.get("frames", 0),
+            span = ev.get("duration_s")
+            if ok and span:
+                spans[mode].append(span)
+            restarted[mode] += bool(vio.get("start_restarts"))
+            print("%-4s %-4s %-12s %7s %7d %9s %3d %9s %10s %7s %8s %8s %7s %5s %7s  %s" % (
+                seq, seed, mode, r["status"], r.get("frames", 0), "%.2f" % span if ok and span else "-",
+                len(vio.get("start_restarts") or []),
                 "%.1f" % (1e3 * se3) if se3 is not None else "-",
                 "%.1f" % (1e3 * sim3) if sim3 is not None else "-",
                 "%.3f" % scale if scale is not None else "-",
@@ -170,6 +179,9 @@ if len(seqs) > 1:
         print(line)
 med = {m: inf_median(v) for m, v in allv.items()}
 print("medians of the SE(3) ATE over all runs (failed = inf): " + ", ".join("%s %s mm" % (m, mm(v)) for m, v in med.items()))
+print("evaluated span of successful runs (s), median / min: " + ", ".join(
+    "%s %s" % (m, "%.2f / %.2f" % (statistics.median(v), min(v)) if v else "-") for m, v in spans.items()) +
+    "; runs with a restarted start: " + ", ".join("%s %d" % (m, n) for m, n in restarted.items()))
 print("failed runs: " + ", ".join("%s %d/%d" % (m, sum(x == float("inf") for x in v), len(v)) for m, v in allv.items()))
 if "rsvio_rs" in med and "gsvio_gs" in med:
     print("rs_vio on RS vs gs_vio on the twin %.2fx" % (med["rsvio_rs"] / med["gsvio_gs"]))

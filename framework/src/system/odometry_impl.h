@@ -14,7 +14,9 @@
 //                                          (backend/bundle_adjustment.h), as the smooth-motion term does.
 //
 // Odometry::Impl (odometry.cpp) is the frame loop and the order of things: it decides keyframes,
-// calls the parts in DSO's makeKeyFrame order and keeps the run's status (initialised, failed).
+// calls the parts in DSO's makeKeyFrame order and keeps the run's status (initialised, failed). A start
+// that is begun again (InertialOptions::init_restart_refusals) gets a new window, tracking and monocular
+// start, and an inertial state with only the old one's IMU buffer; the record stays and drops the attempt.
 // The parts do not know each other, except that the window hands what leaves it to a WindowSink
 // (the run record).
 #pragma once
