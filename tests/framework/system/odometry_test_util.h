@@ -64,10 +64,14 @@ struct RunOutcome {
 };
 
 // Feeds the dataset to the estimator. `modify(i, frame)` may replace images (broken-input tests).
-// `imu_modify(sample)` may change IMU samples before the estimator sees them.
+// `imu_modify(sample)` may change IMU samples before the estimator sees them. `after(odo, i)` is called
+// after frame i and once after finish() with i = kAfterFinish (to take rows and points as `rsvio run`
+// streams them).
+constexpr size_t kAfterFinish = static_cast<size_t>(-1);
 inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& cfg, long max_frames = -1,
                              const std::function<void(size_t, Frame&)>& modify = nullptr,
-                             const std::function<void(ImuSample&)>& imu_modify = nullptr) {
+                             const std::function<void(ImuSample&)>& imu_modify = nullptr,
+                             const std::function<void(Odometry&, size_t)>& after = nullptr) {
   PluginHost& host = contractHost();
   auto source = host.create<DataSource>(cfg.at("source").at("plugin").get<std::string>(), slotParams(cfg, "source"));
   source->open(dataset);
@@ -93,9 +97,11 @@ inline RunOutcome runDataset(const std::string& dataset, const nlohmann::json& c
     } else if (out.first_tracked >= 0) {
       ++out.untracked_after_first;
     }
+    if (after) after(odo, i);
     if (odo.failed()) break;
   }
   odo.finish();
+  if (after) after(odo, kAfterFinish);
   out.failed = odo.failed();
   out.reason = odo.failureReason();
   out.keyframes = odo.numKeyframes();

@@ -188,34 +188,15 @@ struct StreamedRun {
 
 StreamedRun runStreamed(const std::string& dataset, const nlohmann::json& cfg,
                         const std::function<void(size_t, Frame&)>& modify = nullptr) {
-  PluginHost& host = test::contractHost();
-  auto source = host.create<DataSource>(cfg.at("source").at("plugin").get<std::string>(), slotParams(cfg, "source"));
-  source->open(dataset);
-  Odometry odo(cfg, host, source->sensors());
   StreamedRun r;
-  const std::vector<ImuSample>& imu = source->imu();
-  size_t k = 0;
   std::vector<MapPoint> points;
-  for (size_t i = 0; i < source->numFrames(); ++i) {
-    Frame f = source->readFrame(i);
-    while (k < imu.size() && imu[k].t_ns <= f.t_ns) odo.addImu(imu[k++]);
-    if (modify) modify(i, f);
-    const FrameStatus st = odo.addFrame(f);
-    r.out.messages.push_back(st.message);
-    if (st.tracked) ++r.out.tracked;
+  r.out = test::runDataset(dataset, cfg, -1, modify, nullptr, [&](Odometry& odo, size_t i) {
     odo.takeDiagnostics(&r.rows);
+    if (i == test::kAfterFinish) return;
     const size_t before = points.size();
     odo.takePoints(&points);
     r.points_taken_at.insert(r.points_taken_at.end(), points.size() - before, static_cast<long>(i));
-    if (odo.failed()) break;
-  }
-  odo.finish();
-  odo.takeDiagnostics(&r.rows);
-  r.out.failed = odo.failed();
-  r.out.reason = odo.failureReason();
-  r.out.frame_traj = odo.frameTrajectory();
-  r.out.vio = odo.inertialReport();
-  r.out.warnings = odo.warnings();
+  });
   if (r.out.vio.is_object() && r.out.vio.contains("start_restarts"))
     for (const auto& e : r.out.vio.at("start_restarts")) r.restart_frames.push_back(e.at("frame").get<int64_t>());
   return r;
