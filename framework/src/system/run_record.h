@@ -15,7 +15,8 @@
 // Invariants
 // - Frame indices are unique (sequence positions). Records are only appended, except that a frame's
 //   record is refined when it becomes a keyframe or is tracked after the monocular start, and a
-//   keyframe's record whenever its keyframe is optimised again.
+//   keyframe's record whenever its keyframe is optimised again; a restart (restart()) makes every frame
+//   so far untracked and drops what the discarded attempt made (keyframe ids start again at 0 after it).
 // - It sees the window only through what it is given: it is the window's WindowSink (what leaves
 //   arrives in the order it leaves) and the outputs take the live window, whose keyframes and points
 //   are reported with their current state in place of their records.
