@@ -134,7 +134,6 @@ Odometry::Impl::Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSe
 }
 
 void Odometry::Impl::makeParts() {
-  if (!window) window = std::make_unique<KeyframeWindow>(window_setup, *camera, timing, *solver);
   tracking = std::make_unique<Tracking>(tracker_options, *camera, timing, motion_ptrs);
   start = std::make_unique<MonoStart>(bo, *camera, timing);
   if (!inertial) return;

@@ -92,8 +92,8 @@ struct Odometry::Impl {
   nlohmann::json restarts = nlohmann::json::array();
 
   Impl(const nlohmann::json& cfg, PluginHost& host, const SensorSetup& s);
-  // The window, tracking and monocular start from window_setup, tracker_options and motion_ptrs,
-  // wired to the inertial state (when there is one) and the record.
+  // The tracking and monocular start from tracker_options and motion_ptrs, and the window (made by the
+  // caller from window_setup) wired to the inertial state (when there is one) and the record.
   void makeParts();
   // A restart may still happen at camera time t_ns (the contract of InertialOptions::init_restart_refusals).
   bool canRestart(int64_t t_ns) const;

@@ -209,7 +209,7 @@ StreamedRun runStreamed(const std::string& dataset, const nlohmann::json& cfg,
 // point taken before it (the record is provisional until then). Without the restart the same run writes
 // rows of those frames (so the row check can fail). Shown once: with RunRecord::takeObservations and
 // takePoints not holding back while provisional, the row and point checks fail here and the row check of
-// the next test fails.
+// the next test fails; with RunRecord::restart leaving the frames tracked, the pose check fails.
 TEST(VisualInertial, AStartTheImuDoesNotFitIsBegunAgainAndNothingOfItIsWritten) {
   const std::string data = simDataset("tiny_gs");
   const StreamedRun r = runStreamed(data, runConfig("gs_vio", {"imu.init_max_imu_chi2=1e-12",
@@ -233,9 +233,14 @@ TEST(VisualInertial, AStartTheImuDoesNotFitIsBegunAgainAndNothingOfItIsWritten) 
   for (const std::string& w : r.out.warnings)
     warned += w.find("discarded at frame " + std::to_string(R)) != std::string::npos;
   EXPECT_EQ(warned, 1);
-  // The poses: none of a frame up to the restart (frame R's stamp: the messages say where it was).
+  // The poses: none of a frame up to the restart.
   ASSERT_GT(r.out.messages.size(), static_cast<size_t>(R));
   EXPECT_EQ(r.out.messages[R].rfind("restarted", 0), 0u) << r.out.messages[R];
+  const nlohmann::json cfg = runConfig("gs_vio");
+  auto source = test::contractHost().create<DataSource>(cfg.at("source").at("plugin").get<std::string>(),
+                                                        slotParams(cfg, "source"));
+  source->open(data);
+  EXPECT_GT(t_restart, source->readFrame(static_cast<size_t>(R)).t_ns) << "a frame of the discarded attempt has a pose";
   const StreamedRun off = runStreamed(data, runConfig("gs_vio", {"imu.init_max_imu_chi2=1e-12",
                                                                  "imu.init_restart_refusals=0"}));
   ASSERT_TRUE(off.restart_frames.empty());
