@@ -110,6 +110,11 @@ ParamTable inertialParamTable() {
                   "(exploding IMU residuals; a consistent factor has about 15)"),
       paramDouble("fail_grace_s", d.fail_grace_s, 0.0, 1e6, "s",
                   "the IMU residual test starts this long after the initialisation (the scale settles first)"),
+      paramDouble("fail_sustained_imu_chi2", d.fail_sustained_imu_chi2, 0.0, 1e300, "",
+                  "the run fails when the window's mean whitened IMU factor energy stays above this in every "
+                  "optimisation over imu.fail_sustained_s (a window that broke and does not recover; 0 = off)"),
+      paramDouble("fail_sustained_s", d.fail_sustained_s, 0.0, 1e6, "s",
+                  "how long (keyframe time) the IMU energy must stay above imu.fail_sustained_imu_chi2"),
   };
 }
 
@@ -153,6 +158,8 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.fail_max_scale_change = p.getDouble("fail_max_scale_change");
   o.fail_max_imu_chi2 = p.getDouble("fail_max_imu_chi2");
   o.fail_grace_s = p.getDouble("fail_grace_s");
+  o.fail_sustained_imu_chi2 = p.getDouble("fail_sustained_imu_chi2");
+  o.fail_sustained_s = p.getDouble("fail_sustained_s");
   return o;
 }
 

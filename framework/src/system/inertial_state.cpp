@@ -278,7 +278,7 @@ void InertialState::refreshFactors(KeyframeList& window) {
   }
 }
 
-std::string InertialState::checkDivergence(const KeyframeList& window) const {
+std::string InertialState::checkDivergence(const KeyframeList& window) {
   if (!initialised_) return "";
   std::ostringstream os;
   const double s = scale();
@@ -311,6 +311,21 @@ std::string InertialState::checkDivergence(const KeyframeList& window) const {
   if (n > 0 && (!std::isfinite(chi2) || (settled && !(chi2 / n <= o_.fail_max_imu_chi2)))) {
     os << "exploding IMU residuals: mean whitened energy " << chi2 / n << " per factor > imu.fail_max_imu_chi2 "
        << o_.fail_max_imu_chi2;
+    return os.str();
+  }
+  // Sustained: every optimisation since high_chi2_since_ns_ had a mean above the limit.
+  if (!settled || n == 0 || !(o_.fail_sustained_imu_chi2 > 0.0) || chi2 / n <= o_.fail_sustained_imu_chi2) {
+    high_chi2_since_ns_ = -1;
+    return "";
+  }
+  const int64_t t_ns = window.back()->t_ns;
+  if (high_chi2_since_ns_ < 0) high_chi2_since_ns_ = t_ns;
+  if (nsToS(t_ns - high_chi2_since_ns_) >= o_.fail_sustained_s) {
+    os << "IMU residuals stay high: mean whitened energy above imu.fail_sustained_imu_chi2 "
+       << o_.fail_sustained_imu_chi2 << " per factor for " << nsToS(t_ns - high_chi2_since_ns_)
+       << " s (now " << chi2 / n << "; imu.fail_sustained_s " << o_.fail_sustained_s
+       << "): the window no longer fits the IMU (it broke, or the model lacks an effect such as a camera-IMU "
+          "time offset; rsvio diagnose on this run)";
     return os.str();
   }
   return "";

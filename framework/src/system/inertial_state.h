@@ -72,8 +72,9 @@ class InertialState {
 
   // After an optimisation: re-preintegrates the factors whose bias or offset moved too far.
   void refreshFactors(KeyframeList& window);
-  // "" or the reason the estimate diverged (bias runaway, scale collapse, exploding IMU residuals).
-  std::string checkDivergence(const KeyframeList& window) const;
+  // "" or the reason the estimate diverged (bias runaway, scale collapse, exploding IMU residuals, IMU
+  // residuals that stay high). Call once after each optimisation: it keeps when the energy rose.
+  std::string checkDivergence(const KeyframeList& window);
 
   // The inertial part of a tracked frame's motion state, propagated from keyframe `ref` to t_ns.
   void fillMotionState(const Keyframe& ref, MotionState* ms) const;
@@ -127,6 +128,7 @@ class InertialState {
   bool initialised_ = false;
   double scale_init_ = 1.0;
   int64_t init_t_ns_ = 0;
+  int64_t high_chi2_since_ns_ = -1;  // first keyframe time of the current run of high IMU energy (-1: none)
   std::string status_ = "waiting for keyframes";
   int refusals_ = 0;
   std::string first_refusal_;

@@ -55,6 +55,8 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["fail_max_scale_change"] = o.fail_max_scale_change;
   got["fail_max_imu_chi2"] = o.fail_max_imu_chi2;
   got["fail_grace_s"] = o.fail_grace_s;
+  got["fail_sustained_imu_chi2"] = o.fail_sustained_imu_chi2;
+  got["fail_sustained_s"] = o.fail_sustained_s;
   test::expectEveryKeyRead("imu", table, sec, got);
 }
 
@@ -68,6 +70,8 @@ TEST(InertialOptions, TheTablesDefaultsAreTheStructs) {
   EXPECT_DOUBLE_EQ(o.init_max_imu_chi2, d.init_max_imu_chi2);
   EXPECT_DOUBLE_EQ(o.dynamic_marginalization_interval, d.dynamic_marginalization_interval);
   EXPECT_DOUBLE_EQ(o.fail_grace_s, d.fail_grace_s);
+  EXPECT_DOUBLE_EQ(o.fail_sustained_imu_chi2, d.fail_sustained_imu_chi2);
+  EXPECT_DOUBLE_EQ(o.fail_sustained_s, d.fail_sustained_s);
 }
 
 TEST(InertialOptions, AMisspeltKeyIsNamed) {

@@ -128,6 +128,12 @@ struct InertialOptions {
   double fail_max_scale_change = 5.0;   // scale vs the initialisation's, either way
   double fail_max_imu_chi2 = 1e5;       // mean whitened IMU factor energy per factor in the window
   double fail_grace_s = 2.0;            // the residual test starts this long after the initialisation
+  // A window that broke and stays broken: the run fails when the mean whitened IMU factor energy per
+  // factor stayed above fail_sustained_imu_chi2 in every optimisation over fail_sustained_s of keyframe
+  // time (from fail_grace_s after the initialisation; 0 = off). Short bursts after fast motion recover
+  // within 0.1-0.3 s; docs/vio.md "Divergence".
+  double fail_sustained_imu_chi2 = 0.0;
+  double fail_sustained_s = 1.0;
 
   static InertialOptions fromParams(const Params& p);
   // The camera-IMU time offset a run assumes (t_imu = t_cam + offset) [s]: the calibration's plus
