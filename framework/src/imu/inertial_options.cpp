@@ -111,10 +111,17 @@ ParamTable inertialParamTable() {
       paramDouble("fail_grace_s", d.fail_grace_s, 0.0, 1e6, "s",
                   "the IMU residual test starts this long after the initialisation (the scale settles first)"),
       paramDouble("fail_sustained_imu_chi2", d.fail_sustained_imu_chi2, 0.0, 1e300, "",
-                  "the run fails when the window's mean whitened IMU factor energy stays above this in every "
-                  "optimisation over imu.fail_sustained_s (a window that broke and does not recover; 0 = off)"),
+                  "the run fails when the window's mean whitened IMU factor energy stays above this and above "
+                  "imu.fail_sustained_factor x the run's own level for imu.fail_sustained_s (a window that broke; "
+                  "0 = off)"),
+      paramDouble("fail_sustained_factor", d.fail_sustained_factor, 1.0, 1e12, "",
+                  "times the run's own IMU energy level (its median over the first imu.fail_sustained_s after "
+                  "imu.fail_grace_s) that a broken window stays above"),
       paramDouble("fail_sustained_s", d.fail_sustained_s, 0.0, 1e6, "s",
-                  "how long (keyframe time) the IMU energy must stay above imu.fail_sustained_imu_chi2"),
+                  "keyframe time over which the run's IMU energy level is taken, and how long it must stay high"),
+      paramDouble("warn_imu_chi2", d.warn_imu_chi2, 0.0, 1e300, "",
+                  "a warning when the median mean whitened IMU factor energy after imu.fail_grace_s is above "
+                  "this (the model does not fit the IMU; 0 = none)"),
   };
 }
 
@@ -159,7 +166,9 @@ InertialOptions InertialOptions::fromParams(const Params& p) {
   o.fail_max_imu_chi2 = p.getDouble("fail_max_imu_chi2");
   o.fail_grace_s = p.getDouble("fail_grace_s");
   o.fail_sustained_imu_chi2 = p.getDouble("fail_sustained_imu_chi2");
+  o.fail_sustained_factor = p.getDouble("fail_sustained_factor");
   o.fail_sustained_s = p.getDouble("fail_sustained_s");
+  o.warn_imu_chi2 = p.getDouble("warn_imu_chi2");
   return o;
 }
 

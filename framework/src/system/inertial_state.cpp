@@ -1,6 +1,7 @@
 // The inertial part of the estimator (contract in inertial_state.h).
 #include "inertial_state.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -313,22 +314,53 @@ std::string InertialState::checkDivergence(const KeyframeList& window) {
        << o_.fail_max_imu_chi2;
     return os.str();
   }
-  // Sustained: every optimisation since high_chi2_since_ns_ had a mean above the limit.
-  if (!settled || n == 0 || !(o_.fail_sustained_imu_chi2 > 0.0) || chi2 / n <= o_.fail_sustained_imu_chi2) {
+  if (!settled || n == 0) return "";
+  // Sustained: the run's level is the median of its first fail_sustained_s after the grace; after it,
+  // every optimisation since high_chi2_since_ns_ had a mean above max(limit, factor x level).
+  const int64_t t_ns = window.back()->t_ns;
+  const double mean = chi2 / n;
+  energies_.emplace_back(t_ns, mean);
+  if (!(o_.fail_sustained_imu_chi2 > 0.0)) return "";
+  if (energy_level_ < 0.0) {
+    if (nsToS(t_ns - energies_.front().first) < o_.fail_sustained_s) return "";
+    std::vector<double> v;
+    for (const auto& e : energies_) v.push_back(e.second);
+    v.pop_back();  // the level is of the span before this optimisation
+    if (v.empty()) v.push_back(mean);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    energy_level_ = v[v.size() / 2];
+  }
+  const double limit = std::max(o_.fail_sustained_imu_chi2, o_.fail_sustained_factor * energy_level_);
+  if (!(mean > limit)) {
     high_chi2_since_ns_ = -1;
     return "";
   }
-  const int64_t t_ns = window.back()->t_ns;
   if (high_chi2_since_ns_ < 0) high_chi2_since_ns_ = t_ns;
   if (nsToS(t_ns - high_chi2_since_ns_) >= o_.fail_sustained_s) {
-    os << "IMU residuals stay high: mean whitened energy above imu.fail_sustained_imu_chi2 "
-       << o_.fail_sustained_imu_chi2 << " per factor for " << nsToS(t_ns - high_chi2_since_ns_)
-       << " s (now " << chi2 / n << "; imu.fail_sustained_s " << o_.fail_sustained_s
-       << "): the window no longer fits the IMU (it broke, or the model lacks an effect such as a camera-IMU "
-          "time offset; rsvio diagnose on this run)";
+    os << "IMU residuals stay high: mean whitened energy per factor above " << limit << " for "
+       << nsToS(t_ns - high_chi2_since_ns_) << " s (now " << mean << "; the run's level " << energy_level_
+       << "; imu.fail_sustained_imu_chi2 " << o_.fail_sustained_imu_chi2 << ", imu.fail_sustained_factor "
+       << o_.fail_sustained_factor << ", imu.fail_sustained_s " << o_.fail_sustained_s
+       << "): the window broke and no longer fits the IMU";
     return os.str();
   }
   return "";
+}
+
+std::string InertialState::residualWarning() const {
+  if (!(o_.warn_imu_chi2 > 0.0) || energies_.empty()) return "";
+  std::vector<double> v;
+  for (const auto& e : energies_) v.push_back(e.second);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  const double median = v[v.size() / 2];
+  if (!(median > o_.warn_imu_chi2)) return "";
+  std::ostringstream os;
+  os << "the window's IMU residuals stayed high: median whitened energy " << median << " per factor over "
+     << energies_.size() << " optimisations after the initialisation (a consistent factor has about 15; "
+     << "imu.warn_imu_chi2 " << o_.warn_imu_chi2
+     << "): the model does not fit the IMU, for example an unmodelled camera-IMU time offset; rsvio diagnose "
+        "on this run looks for the effect it lacks";
+  return os.str();
 }
 
 void InertialState::fillMotionState(const Keyframe& ref, MotionState* ms) const {

@@ -75,6 +75,8 @@ class InertialState {
   // "" or the reason the estimate diverged (bias runaway, scale collapse, exploding IMU residuals, IMU
   // residuals that stay high). Call once after each optimisation: it keeps when the energy rose.
   std::string checkDivergence(const KeyframeList& window);
+  // "" or a warning that the window's IMU energy stayed high over the run (InertialOptions::warn_imu_chi2).
+  std::string residualWarning() const;
 
   // The inertial part of a tracked frame's motion state, propagated from keyframe `ref` to t_ns.
   void fillMotionState(const Keyframe& ref, MotionState* ms) const;
@@ -128,7 +130,11 @@ class InertialState {
   bool initialised_ = false;
   double scale_init_ = 1.0;
   int64_t init_t_ns_ = 0;
-  int64_t high_chi2_since_ns_ = -1;  // first keyframe time of the current run of high IMU energy (-1: none)
+  // The window's mean IMU energy per factor after each optimisation from fail_grace_s on (keyframe time,
+  // value): the run's level, the stretch of high energy, the warning at the end.
+  std::vector<std::pair<int64_t, double>> energies_;
+  double energy_level_ = -1.0;       // median over the first fail_sustained_s of energies_ (-1: not yet)
+  int64_t high_chi2_since_ns_ = -1;  // first keyframe time of the current stretch of high energy (-1: none)
   std::string status_ = "waiting for keyframes";
   int refusals_ = 0;
   std::string first_refusal_;

@@ -597,6 +597,10 @@ void Odometry::Impl::finish() {
           "initialisation may be broken";
     record->addWarning(os.str());
   }
+  if (inertial) {
+    const std::string w = inertial->residualWarning();
+    if (!w.empty()) record->addWarning(w);
+  }
   if (poorly_explained_frames > 0) {
     std::ostringstream os;
     os << poorly_explained_frames << " of " << record->frames().size()

@@ -56,7 +56,9 @@ TEST(InertialOptions, EveryTableKeyIsRead) {
   got["fail_max_imu_chi2"] = o.fail_max_imu_chi2;
   got["fail_grace_s"] = o.fail_grace_s;
   got["fail_sustained_imu_chi2"] = o.fail_sustained_imu_chi2;
+  got["fail_sustained_factor"] = o.fail_sustained_factor;
   got["fail_sustained_s"] = o.fail_sustained_s;
+  got["warn_imu_chi2"] = o.warn_imu_chi2;
   test::expectEveryKeyRead("imu", table, sec, got);
 }
 
@@ -71,7 +73,9 @@ TEST(InertialOptions, TheTablesDefaultsAreTheStructs) {
   EXPECT_DOUBLE_EQ(o.dynamic_marginalization_interval, d.dynamic_marginalization_interval);
   EXPECT_DOUBLE_EQ(o.fail_grace_s, d.fail_grace_s);
   EXPECT_DOUBLE_EQ(o.fail_sustained_imu_chi2, d.fail_sustained_imu_chi2);
+  EXPECT_DOUBLE_EQ(o.fail_sustained_factor, d.fail_sustained_factor);
   EXPECT_DOUBLE_EQ(o.fail_sustained_s, d.fail_sustained_s);
+  EXPECT_DOUBLE_EQ(o.warn_imu_chi2, d.warn_imu_chi2);
 }
 
 TEST(InertialOptions, AMisspeltKeyIsNamed) {
