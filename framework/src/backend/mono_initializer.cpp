@@ -12,6 +12,7 @@
 #include <sstream>
 #include <utility>
 
+#include "rsvio/core/median.h"
 #include "rsvio/core/time.h"
 #include "rsvio/interfaces/camera.h"
 
@@ -32,12 +33,6 @@ bool boxMean(const ImageLevel& level, const Vec2& p, float* mean) {
 constexpr int kHalfWin = 4;       // 9x9 Lucas-Kanade window
 constexpr int kLkIterations = 12;
 constexpr int kRansacIterations = 400;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 // Pyramidal Lucas-Kanade of one point from `a` to `b` (zero-mean SSD over a 9x9 window, inverse
 // compositional per level). Returns false when the point leaves an image or the window is flat.
@@ -212,7 +207,7 @@ bool fitRotationRate(const std::vector<Eigen::Vector3d>& a, const std::vector<do
   if (n < 8 || !solve(3)) return false;
   std::vector<double> res(n);
   for (size_t k = 0; k < n; ++k) res[k] = (b[k] - SO3d::exp(x * (dt + tau_b[k] - tau_a[k])) * a[k]).norm();
-  const double lim = 3.0 * median(res);
+  const double lim = 3.0 * upperMedian(res);
   for (size_t k = 0; k < n; ++k) use[k] = res[k] <= lim ? 1 : 0;
   if (!solve(2)) return false;
   *w = x;
@@ -340,14 +335,14 @@ double MonoInitializer::logGainCurRef() const {
         boxMean(prev_->level(0), Vec2(cur_pts_[i].x, cur_pts_[i].y), &cur) && cur > 0.f)
       ratio.push_back(static_cast<double>(cur) / ref_intensity_[i]);
   }
-  return ratio.size() < 20 ? 0.0 : std::log(median(std::move(ratio)));
+  return ratio.size() < 20 ? 0.0 : std::log(upperMedian(std::move(ratio)));
 }
 
 bool MonoInitializer::tryInitialise() {
   const int w = camera_.width(), h = camera_.height();
   std::vector<double> flow;
   for (size_t i = 0; i < cur_pts_.size(); ++i) flow.push_back(std::hypot(cur_pts_[i].x - ref_pts_[i].x, cur_pts_[i].y - ref_pts_[i].y));
-  const double med_flow = median(flow);
+  const double med_flow = upperMedian(flow);
   if (med_flow < options_.init_min_flow_px * std::hypot(w, h)) {
     std::ostringstream os;
     os << "median corner flow " << med_flow << " px is small";
@@ -602,7 +597,7 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
   r.inliers = static_cast<int>(fit.in.size());
   r.inlier_ratio = static_cast<double>(fit.in.size()) / m;
   r.front = fit.front;
-  r.parallax_deg = median(fit.angle) * 180.0 / M_PI;
+  r.parallax_deg = upperMedian(fit.angle) * 180.0 / M_PI;
   std::ostringstream os;
   os << "essential matrix: " << fit.in.size() << "/" << m << " inliers, " << fit.front << " in front, median parallax "
      << r.parallax_deg << " deg";
@@ -615,7 +610,7 @@ TwoViewResult solveTwoView(const std::vector<Vec2>& ref_px, const std::vector<Ve
   for (int i : fit.in)
     if (std::isfinite(fit.d1[static_cast<size_t>(i)])) depth.push_back(fit.d1[static_cast<size_t>(i)]);
   r.num_depths = static_cast<int>(depth.size());
-  const double med_depth = median(depth);
+  const double med_depth = upperMedian(depth);
   if (depth.empty() || !(med_depth > 0)) return r;
   r.T_cur_ref = SE3d(Eigen::Quaterniond(fit.R).normalized(), fit.t / med_depth);
   if (rolling && dt_s > 0) r.xi = r.T_cur_ref.log() / dt_s;

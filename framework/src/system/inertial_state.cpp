@@ -1,10 +1,10 @@
 // The inertial part of the estimator (contract in inertial_state.h).
 #include "inertial_state.h"
 
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
+#include "rsvio/core/median.h"
 #include "rsvio/core/time.h"
 #include "rsvio/imu/imu_factor.h"
 #include "rsvio/imu/imu_frames.h"
@@ -326,9 +326,7 @@ std::string InertialState::checkDivergence(const KeyframeList& window) {
     std::vector<double> v;
     for (const auto& e : energies_) v.push_back(e.second);
     v.pop_back();  // the level is of the span before this optimisation
-    if (v.empty()) v.push_back(mean);
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    energy_level_ = v[v.size() / 2];
+    energy_level_ = v.empty() ? mean : upperMedian(v);
   }
   const double limit = std::max(o_.fail_sustained_imu_chi2, o_.fail_sustained_factor * energy_level_);
   if (!(mean > limit)) {
@@ -351,8 +349,7 @@ std::string InertialState::residualWarning() const {
   if (!(o_.warn_imu_chi2 > 0.0) || energies_.empty()) return "";
   std::vector<double> v;
   for (const auto& e : energies_) v.push_back(e.second);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  const double median = v[v.size() / 2];
+  const double median = upperMedian(v);
   if (!(median > o_.warn_imu_chi2)) return "";
   std::ostringstream os;
   os << "the window's IMU residuals stayed high: median whitened energy " << median << " per factor over "
