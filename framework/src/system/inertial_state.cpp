@@ -355,8 +355,9 @@ std::string InertialState::residualWarning() const {
   os << "the window's IMU residuals stayed high: median whitened energy " << median << " per factor over "
      << energies_.size() << " optimisations after the initialisation (a consistent factor has about 15; "
      << "imu.warn_imu_chi2 " << o_.warn_imu_chi2
-     << "): the model does not fit the IMU, for example an unmodelled camera-IMU time offset; rsvio diagnose "
-        "on this run looks for the effect it lacks";
+     << "): the trajectory the images give does not fit the IMU; the model lacks an effect (a rolling shutter, a "
+        "camera-IMU time offset, ...) or the IMU noise or calibration is wrong; rsvio diagnose on this run looks "
+        "for the effect it lacks";
   return os.str();
 }
 
