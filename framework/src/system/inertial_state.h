@@ -73,7 +73,8 @@ class InertialState {
   // After an optimisation: re-preintegrates the factors whose bias or offset moved too far.
   void refreshFactors(KeyframeList& window);
   // "" or the reason the estimate diverged (bias runaway, scale collapse, exploding IMU residuals, IMU
-  // residuals that stay high). Call once after each optimisation: it keeps when the energy rose.
+  // residuals that stay high). Call once after each keyframe's optimisation: it records the window's IMU
+  // energy each time (the run's level, the stretch above it, residualWarning).
   std::string checkDivergence(const KeyframeList& window);
   // "" or a warning that the window's IMU energy stayed high over the run (InertialOptions::warn_imu_chi2).
   std::string residualWarning() const;
