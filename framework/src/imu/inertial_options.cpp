@@ -34,7 +34,8 @@ ParamTable inertialParamTable() {
                 "at the frame's time (gyro bias 0), its translation from the tracked frames"),
       paramBool("init_rates_from_gyro", d.init_rates_from_gyro,
                 "rolling shutter: the monocular start's rotation rate of each image from the gyroscope at its time "
-                "(gyro bias 0) instead of from the corner tracks (backend.init_rotation_rates)"),
+                "(gyro bias 0) instead of from the corner tracks (backend.init_rotation_rates); not while the time "
+                "offset is searched (estimate_time_offset with init_time_offset_search_ms > 0)"),
       paramBool("init_track_guess_from_gyro", d.init_track_guess_from_gyro,
                 "the monocular start's corner tracks start each search where the gyroscope's rotation since the "
                 "previous frame moves the corner (gyro bias 0), plus the flow the rotation left unexplained in the "

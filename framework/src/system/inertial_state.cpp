@@ -71,6 +71,15 @@ void InertialState::linkTwistEnergy(Keyframe& kf) const {
   kf.twist_energy = true;
 }
 
+void InertialState::relinkBeforeInit(KeyframeList& window) const {
+  if (initialised_) return;
+  for (auto& kf : window) {
+    if (twistBeforeInit()) linkTwistEnergy(*kf);
+    if (gyroBeforeInit() && kf->imu_term && kf->imu_prev)
+      if (std::shared_ptr<const ImuFactor> f = makeFactor(*kf->imu_prev, *kf)) kf->imu_factor = f;
+  }
+}
+
 std::string InertialState::onNewKeyframe(Keyframe& kf, Keyframe* newest) {
   kf.imu_term = false;
   kf.imu_prev = nullptr;
@@ -128,9 +137,15 @@ bool InertialState::tryInitialize(const std::vector<ViInitKeyframe>& keyframes, 
   // and the gyroscope agree on, searched around the starting one (calibration plus correction) at each
   // attempt; the gyroscope's rotations used before the initialisation (frame rotations, twists) and the
   // initialisation then see the IMU at the right time, and the online estimate starts there.
-  if (o_.estimate_time_offset && o_.init_time_offset_search_ms > 0.0 && kfs.size() >= 3)
+  // The window's terms before the initialisation then read the gyroscope again at the new offset
+  // (relinkBeforeInit): the keyframes' rotations the next search sees are no longer pulled toward the
+  // old one, so the searches converge on the offset the images give instead of stopping short of it.
+  if (searchesOffset() && kfs.size() >= 3) {
+    const double before = globals_.state.time_offset_s;
     globals_.state.time_offset_s = estimateTimeOffset(kfs, buffer_, sensors_.imu, T_cm_i_,
                                                       sensors_.camera.time_offset_s, 1e-3 * o_.init_time_offset_search_ms);
+    if (globals_.state.time_offset_s != before) relinkBeforeInit(window);
+  }
   if (static_cast<int>(kfs.size()) < o_.init_min_keyframes) {
     std::ostringstream os;
     os << "waiting for keyframes with IMU data: " << kfs.size() << " < imu.init_min_keyframes "

@@ -107,6 +107,8 @@ class InertialState {
   bool gyroBeforeInit() const { return o_.gyro_bias_sigma_before_init_rad_s > 0.0; }
   bool twistBeforeInit() const { return rolling_ && o_.twist_gyro_sigma_before_init_rad_s > 0.0; }
   bool termsBeforeInit() const { return gyroBeforeInit() || twistBeforeInit(); }
+  // The offset is estimated and searched before the initialisation (init_time_offset_search_ms).
+  bool searchesOffset() const { return o_.estimate_time_offset && o_.init_time_offset_search_ms > 0.0; }
   const InertialTerm* inertialTerm() const { return term_.get(); }
   GlobalStates& globals() { return globals_; }
   const GlobalStates& globals() const { return globals_; }
@@ -118,6 +120,9 @@ class InertialState {
  private:
   std::shared_ptr<const ImuFactor> makeFactor(const Keyframe& from, const Keyframe& to) const;
   void linkTwistEnergy(Keyframe& kf) const;
+  // Before the initialisation, after the offset moved: the window keyframes' twist energies read the
+  // gyroscope at the new offset, and their gyroscope factors (gyroBeforeInit) are integrated again.
+  void relinkBeforeInit(KeyframeList& window) const;
   int64_t offsetNs() const;
 
   InertialOptions o_;

@@ -140,7 +140,7 @@ void Odometry::Impl::makeParts() {
   window->setInertial(inertial.get());
   record->setGlobals(&window->globals());
   const InertialState* in = inertial.get();
-  if (rolling && in->options().init_rates_from_gyro)
+  if (rolling && in->options().init_rates_from_gyro && !in->searchesOffset())  // see InertialOptions
     start->setRateSource([in](int64_t t_ns, Vec3* w) { return in->gyroRate(t_ns, Vec3::Zero(), w); });
   if (in->options().init_track_guess_from_gyro)
     start->setTrackGuessSource(

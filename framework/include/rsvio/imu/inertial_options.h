@@ -39,6 +39,10 @@ struct InertialOptions {
   // Rolling shutter: the monocular start's rotation rate of each of its two images from the gyroscope
   // at the image's time (gyro bias 0) instead of fitted from the corner tracks
   // (backend.init_rotation_rates, MonoInitializer::setRateSource); the two keyframes start with them.
+  // Not while the offset is searched (estimate_time_offset with init_time_offset_search_ms > 0): the
+  // offset the gyroscope would be read at is unknown before the first search, which needs the start's
+  // keyframes, and rates read at a wrong one bias that search toward it (docs/vio.md, "The offset search
+  // no longer reads the gyroscope at the offset it searches").
   bool init_rates_from_gyro = false;
   // The monocular start's corner tracks (either shutter): each corner's Lucas-Kanade search starts
   // where the gyroscope's rotation since the previous frame moves it (gyro bias 0), plus the flow the
